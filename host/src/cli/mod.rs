@@ -1,0 +1,107 @@
+//! The `pushbot` command line: `pushbot <noun> <verb>`, the same global flags everywhere.
+//!
+//! Exit codes: 0 success, 1 the task failed (goal not reached, no plan exists, the robot
+//! faulted, the link died), 2 bad input (arguments, scene files, ports that are not serial).
+
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+/// Flags every command takes.
+#[derive(Args, Debug, Clone)]
+pub struct Global {
+    /// Print one JSON object (or JSON lines for streams) instead of text.
+    #[arg(long, global = true)]
+    pub json: bool,
+    /// Seed for everything random (simulation noise, sampling).
+    #[arg(long, global = true, default_value_t = 1)]
+    pub seed: u64,
+    /// More log output (-v info, -vv debug, -vvv trace). Logs go to stderr.
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+}
+
+/// pushbot: a small differential-drive robot that rearranges and delivers objects by pushing.
+#[derive(Parser, Debug)]
+#[command(name = "pushbot", version, about, long_about = None)]
+pub struct Cli {
+    #[command(flatten)]
+    pub global: Global,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Subcommand, Debug)]
+pub enum Command {}
+
+/// How a command that ran to its end went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// It did what was asked: exit 0.
+    Success,
+    /// It ran but the task failed (no plan, goal not reached, fault): exit 1.
+    TaskFailed,
+}
+
+/// Why a command could not do its work.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The input was wrong (arguments, files, devices): exit 2.
+    #[error("{0:#}")]
+    BadInput(anyhow::Error),
+    /// Something failed while working (link lost, I/O): exit 1.
+    #[error("{0:#}")]
+    Failed(#[from] anyhow::Error),
+}
+
+impl CliError {
+    /// A bad-input error with a message.
+    pub fn bad_input(msg: impl std::fmt::Display) -> Self {
+        CliError::BadInput(anyhow::anyhow!("{msg}"))
+    }
+}
+
+/// What every command's `run` returns.
+pub type CliResult = Result<Status, CliError>;
+
+/// Parse arguments, run, map the result to an exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    init_logging(cli.global.verbose);
+    let result = run(cli);
+    match result {
+        Ok(Status::Success) => ExitCode::SUCCESS,
+        Ok(Status::TaskFailed) => ExitCode::from(1),
+        Err(CliError::Failed(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+        Err(CliError::BadInput(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn init_logging(verbose: u8) {
+    let level = match verbose {
+        0 => "warn",
+        1 => "info",
+        2 => "debug",
+        _ => "trace",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_env("PUSHBOT_LOG")
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
+}
+
+/// Run a parsed command line.
+pub fn run(cli: Cli) -> CliResult {
+    let Cli { global, command } = cli;
+    let _ = &global;
+    match command {}
+}

@@ -1,0 +1,7 @@
+//! pushbot host: the PC side of the pushing robot.
+//!
+//! Data flows one way: camera → `vision` → planners (`planner`, `strategy`) → motion
+//! primitives (`exec`) → `link` → firmware → motors. See `DESIGN.md` of the project.
+#![forbid(unsafe_code)]
+
+pub mod cli;

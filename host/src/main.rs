@@ -1,0 +1,4 @@
+//! The `pushbot` command.
+fn main() -> std::process::ExitCode {
+    pushbot::cli::main()
+}

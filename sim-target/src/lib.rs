@@ -1,0 +1,2 @@
+//! The simulated pushbot target.
+#![forbid(unsafe_code)]

@@ -1,0 +1,2 @@
+//! `pushbot-sim`: the simulated robot on a pseudo-terminal.
+fn main() {}
