@@ -46,5 +46,3 @@ macro_rules! error {
         ::log::error!($s $(, $x)*);
     }};
 }
-
-pub(crate) use {debug, error, info, trace, warn};

@@ -20,15 +20,37 @@
 //!   motors off (coast/brake is the board's choice).
 //! * Time is robot time in microseconds, monotonic, handed in by the caller: the core never
 //!   reads a clock, so it runs identically on the board and at simulated time.
+//!
+//! # Parts
+//!
+//! | module | what |
+//! |---|---|
+//! | [`wheel`] | PI wheel-speed control on encoder feedback + feed-forward, anti-windup, saturation; speed estimate |
+//! | [`profile`] | acceleration-limited (trapezoidal) profiles for move/spin, ramps for velocity and braking |
+//! | [`odometry`] | differential-drive odometry from wrap-safe count differences, heading in (−π, π] |
+//! | [`bumper`] | per-switch debouncing, closing edges |
+//! | [`safety`] | link watchdog, stall detection, encoder plausibility, control overrun |
+//! | [`link`] | the robot end of the protocol: frame decoding, retry cache, transmit queue |
+//! | (core) | [`Core`]: the state machine that ties them together (its docs list the policies) |
+//!
+//! The core allocates nothing and does not panic on any input: bytes, sensor readings or time.
+//! Logging goes through a shim (`fmt.rs`): `defmt` with the `defmt` feature, `log` otherwise.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+#[macro_use]
 mod fmt;
 
-mod robot;
+pub mod bumper;
+pub mod link;
+pub mod odometry;
 mod params;
+pub mod profile;
+mod robot;
+pub mod safety;
+pub mod wheel;
 
-pub use robot::{Core, Inputs, Outputs};
 pub use params::{Limits, RobotParams};
 pub use pushbot_protocol::{Faults, FirmwareVersion, Geometry, Mode, Pose, WheelGains};
+pub use robot::{Core, FAULT_QUIET_US, Inputs, Outputs};

@@ -62,6 +62,13 @@ pub struct RobotParams {
     pub distance_tolerance: f32,
     /// Angle tolerance for the end of a spin, rad.
     pub angle_tolerance: f32,
+    /// After a profile has arrived, how long the wheels may take to come within the tolerance
+    /// before the remainder is planned again, ms.
+    pub settle_ms: u16,
+    /// Largest |distance| of a `Move` or `AdvanceUntilContact`, m.
+    pub max_distance: f32,
+    /// Largest |angle| of a `Spin`, rad.
+    pub max_angle: f32,
 }
 
 impl Default for RobotParams {
@@ -113,6 +120,9 @@ impl Default for RobotParams {
             timeout_slack_ms: 1_000,
             distance_tolerance: 0.002,
             angle_tolerance: 0.02,
+            settle_ms: 200,
+            max_distance: 10.0,
+            max_angle: 4.0 * core::f32::consts::PI,
         }
     }
 }
