@@ -1,2 +1,424 @@
 //! `pushbot-sim`: the simulated robot on a pseudo-terminal.
-fn main() {}
+//!
+//! Prints one JSON line first — `{"serial": "/dev/pts/N", "seed": …, "speed": …, "table": [w, h],
+//! …}` — then runs until its standard input closes (or it is killed). A host opens the `serial`
+//! path as it would a real robot's port.
+#![forbid(unsafe_code)]
+
+use std::io::{Read, Write};
+use std::path::PathBuf;
+
+use serde::Serialize;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use anyhow::{Context, Result, bail};
+use clap::Parser;
+use pushbot_sim::faults::LinkFaults;
+use pushbot_sim::pushing::Slider;
+use pushbot_sim::{Pose, PtySim, Scene, SimOptions};
+
+/// The simulated pushbot robot, served on a pseudo-terminal.
+#[derive(Parser, Debug)]
+#[command(version, about, args_conflicts_with_subcommands = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Sub>,
+    /// A scene: a preset name (see `pushbot-sim presets`) or a TOML file. Its table, obstacles,
+    /// objects and robot replace --table and --start.
+    #[arg(long, value_name = "PRESET|FILE")]
+    scene: Option<String>,
+    /// Seed of all simulated noise: the same seed and the same host bytes give the same run.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Simulated seconds per wall-clock second: 1 = real time, 20 = twenty times faster,
+    /// 0 = as fast as possible (unpaced; the host must then not rely on wall-clock timing).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    speed: f64,
+    /// Write the true pose as JSON lines {"t", "x", "y", "theta", "duty", "bumper"} to FILE.
+    #[arg(long, value_name = "FILE")]
+    truth_log: Option<PathBuf>,
+    /// Rate of the truth log, Hz of simulated time.
+    #[arg(long, default_value_t = 100.0, value_name = "HZ")]
+    truth_hz: f64,
+    /// Table width (x) and height (y), metres; origin at the lower-left corner.
+    #[arg(long, num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [1.2, 0.9])]
+    table: Vec<f64>,
+    /// The robot's true start pose: x and y in metres, heading in degrees (default: the table's
+    /// centre, facing +x).
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "HEADING_DEG"], allow_negative_numbers = true)]
+    start: Option<Vec<f64>>,
+    /// Inject link faults (seeded): the default profile is 0.1 % dropped and 0.1 % corrupted
+    /// bytes, bursts delayed up to 20 ms, and a 300 ms cut every 10 s of simulated time.
+    #[arg(long)]
+    faults: bool,
+    /// With --faults: probability that a byte is dropped.
+    #[arg(long, value_name = "P", requires = "faults")]
+    fault_drop: Option<f64>,
+    /// With --faults: probability that a byte has a bit flipped.
+    #[arg(long, value_name = "P", requires = "faults")]
+    fault_corrupt: Option<f64>,
+    /// With --faults: longest delay of a burst of bytes, ms.
+    #[arg(long, value_name = "MS", requires = "faults")]
+    fault_delay_ms: Option<f64>,
+    /// With --faults: cut the link every this many seconds (0 = never)…
+    #[arg(long, value_name = "S", requires = "faults")]
+    fault_cut_every: Option<f64>,
+    /// …for this many seconds.
+    #[arg(long, value_name = "S", requires = "faults")]
+    fault_cut_for: Option<f64>,
+    /// Run until killed instead of until standard input closes.
+    #[arg(long)]
+    no_stdin: bool,
+}
+
+/// The first line on stdout, in this key order.
+#[derive(Serialize)]
+struct FirstLine<'a> {
+    /// Path of the robot's serial port (the pty slave).
+    serial: &'a str,
+    seed: u64,
+    speed: f64,
+    /// Width, height, m.
+    table: [f64; 2],
+    /// True start pose, table frame (heading in radians).
+    start: Pose,
+    /// Firmware control period = physics step, µs of simulated time.
+    tick_us: u32,
+    truth_log: Option<&'a std::path::Path>,
+    /// The scene's name, if a scene was given.
+    scene: Option<&'a str>,
+    /// Object ids, in the order of the truth log's `objects`.
+    objects: Vec<&'a str>,
+    /// Whether link faults are injected.
+    faults: bool,
+    pid: u32,
+}
+
+/// Other things the binary does.
+#[derive(clap::Subcommand, Debug)]
+enum Sub {
+    /// Drive a recorded pusher trajectory against one object of a scene and print the object's
+    /// simulated trajectory (quasi-static pushing, no robot dynamics).
+    Replay {
+        /// Scene: preset name or TOML file.
+        #[arg(long, value_name = "PRESET|FILE")]
+        scene: String,
+        /// The object's id in the scene.
+        #[arg(long)]
+        object: String,
+        /// CSV: time s, pusher x m, y m, θ rad (a header line is allowed); the pusher is a disc
+        /// of the scene robot's bumper radius.
+        #[arg(long, value_name = "FILE.csv")]
+        pusher: PathBuf,
+        /// Print one JSON object instead of CSV lines.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List the built-in scene presets.
+    Presets,
+    /// Measure how fast the in-process simulation runs (robot + firmware + a scene's objects,
+    /// the robot driving and pushing), and print one JSON object.
+    Bench {
+        /// Scene: preset name or TOML file.
+        #[arg(long, default_value = "three-boxes")]
+        scene: String,
+        /// Simulated seconds to run.
+        #[arg(long, default_value_t = 60.0)]
+        seconds: f64,
+    },
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Sub::Replay {
+            ref scene,
+            ref object,
+            ref pusher,
+            json,
+        }) => replay(scene, object, pusher, json),
+        Some(Sub::Bench { ref scene, seconds }) => bench(scene, seconds),
+        Some(Sub::Presets) => {
+            for name in pushbot_sim::scene::PRESETS {
+                println!("{name}");
+            }
+            Ok(())
+        }
+        None => run(cli),
+    };
+    if let Err(e) = result {
+        eprintln!("pushbot-sim: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let [width, height] = cli.table[..] else {
+        bail!("--table takes a width and a height");
+    };
+    let start = match cli.start.as_deref() {
+        None => Pose::new(width / 2.0, height / 2.0, 0.0),
+        Some(&[x, y, deg]) => Pose::new(x, y, deg.to_radians()),
+        Some(_) => bail!("--start takes x, y and a heading"),
+    };
+    let scene = match &cli.scene {
+        Some(s) => Some(Scene::preset_or_file(s)?),
+        None => None,
+    };
+    let (width, height, start) = match &scene {
+        Some(s) => (s.table.width, s.table.height, s.robot.start),
+        None => (width, height, start),
+    };
+    let faults = if cli.faults {
+        let mut f = LinkFaults::default();
+        let prob = |name: &str, p: Option<f64>, default: f64| -> Result<f64> {
+            match p {
+                None => Ok(default),
+                Some(p) if (0.0..=1.0).contains(&p) => Ok(p),
+                Some(p) => bail!("--{name} must be a probability in 0..=1, not {p}"),
+            }
+        };
+        let dur = |name: &str, s: Option<f64>, scale: f64, default: u64| -> Result<u64> {
+            match s {
+                None => Ok(default),
+                Some(s) if s.is_finite() && s >= 0.0 && s * scale < 1e15 => Ok((s * scale) as u64),
+                Some(s) => bail!("--{name} must be a duration ≥ 0, not {s}"),
+            }
+        };
+        f.drop = prob("fault-drop", cli.fault_drop, f.drop)?;
+        f.corrupt = prob("fault-corrupt", cli.fault_corrupt, f.corrupt)?;
+        f.max_delay_us = dur("fault-delay-ms", cli.fault_delay_ms, 1e3, f.max_delay_us)?;
+        f.cut_every_us = dur("fault-cut-every", cli.fault_cut_every, 1e6, f.cut_every_us)?;
+        f.cut_for_us = dur("fault-cut-for", cli.fault_cut_for, 1e6, f.cut_for_us)?;
+        Some(f)
+    } else {
+        None
+    };
+    let opts = SimOptions {
+        faults,
+        scene: scene.clone(),
+        seed: cli.seed,
+        speed: cli.speed,
+        truth_log: cli.truth_log.clone(),
+        truth_hz: cli.truth_hz,
+        start,
+        table: (width, height),
+        ..SimOptions::default()
+    };
+    let sim = PtySim::start(opts.clone())?;
+    let first = FirstLine {
+        serial: sim.serial_path(),
+        seed: opts.seed,
+        speed: opts.speed,
+        table: [width, height],
+        start,
+        tick_us: opts.robot.tick_period_us(),
+        truth_log: opts.truth_log.as_deref(),
+        scene: scene.as_ref().map(|s| s.name.as_str()),
+        objects: scene
+            .as_ref()
+            .map(|s| s.objects.iter().map(|o| o.id.as_str()).collect())
+            .unwrap_or_default(),
+        faults: opts.faults.is_some(),
+        pid: std::process::id(),
+    };
+    {
+        let mut out = std::io::stdout().lock();
+        serde_json::to_writer(&mut out, &first).context("writing to stdout")?;
+        writeln!(out).context("writing to stdout")?;
+        out.flush().context("writing to stdout")?;
+    }
+
+    let (eof_tx, eof_rx) = mpsc::channel::<()>();
+    if !cli.no_stdin {
+        std::thread::spawn(move || {
+            let mut stdin = std::io::stdin().lock();
+            let mut buf = [0u8; 256];
+            // Anything typed is ignored; end of input (or an error) ends the run.
+            while matches!(stdin.read(&mut buf), Ok(n) if n > 0) {}
+            let _ = eof_tx.send(());
+        });
+    }
+    loop {
+        match eof_rx.recv_timeout(Duration::from_millis(100)) {
+            Ok(()) => break,
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            // With --no-stdin the sender is gone at once: run until killed.
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                std::thread::sleep(Duration::from_millis(100))
+            }
+        }
+        if !sim.is_running() {
+            break;
+        }
+    }
+    sim.shutdown()
+}
+
+/// One row of a replayed trajectory.
+#[derive(Serialize)]
+struct ReplayRow {
+    t: f64,
+    x: f64,
+    y: f64,
+    theta: f64,
+    /// How the pusher touched the object on the way to this row (`none` if it did not).
+    contact: &'static str,
+}
+
+fn replay(scene: &str, object: &str, pusher: &std::path::Path, json: bool) -> Result<()> {
+    let scene = Scene::preset_or_file(scene)?;
+    let obj = scene.object(object).with_context(|| {
+        let ids: Vec<&str> = scene.objects.iter().map(|o| o.id.as_str()).collect();
+        format!(
+            "no object {object:?} in the scene (it has: {})",
+            ids.join(", ")
+        )
+    })?;
+    let mut slider = Slider::from_object(obj);
+    let radius = scene.robot.bumper_radius;
+    let text =
+        std::fs::read_to_string(pusher).with_context(|| format!("reading {}", pusher.display()))?;
+    let mut samples: Vec<[f64; 4]> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let parsed: Option<Vec<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
+        match parsed {
+            Some(v) if v.len() == 4 && v.iter().all(|x| x.is_finite()) => {
+                samples.push([v[0], v[1], v[2], v[3]]);
+            }
+            // A header on the first line.
+            None if samples.is_empty() && i == 0 => {}
+            _ => bail!(
+                "{}:{}: expected 4 numbers: time s, x m, y m, theta rad",
+                pusher.display(),
+                i + 1
+            ),
+        }
+    }
+    if samples.is_empty() {
+        bail!("{}: no samples", pusher.display());
+    }
+    if samples.windows(2).any(|w| w[1][0] < w[0][0]) {
+        bail!("{}: time must not decrease", pusher.display());
+    }
+    let first = samples[0];
+    if slider.gap([first[1], first[2]], radius) < -1e-9 {
+        bail!("the pusher starts inside object {object:?}");
+    }
+    let mut rows = Vec::with_capacity(samples.len());
+    let mut prev = first;
+    for s in &samples {
+        let mode = slider.push([prev[1], prev[2]], [s[1], s[2]], radius, 5e-4);
+        prev = *s;
+        rows.push(ReplayRow {
+            t: s[0],
+            x: slider.pose.x,
+            y: slider.pose.y,
+            theta: slider.pose.theta,
+            contact: match mode {
+                None => "none",
+                Some(pushbot_sim::pushing::ContactMode::Separating) => "separating",
+                Some(pushbot_sim::pushing::ContactMode::Sticking) => "sticking",
+                Some(pushbot_sim::pushing::ContactMode::Sliding) => "sliding",
+            },
+        });
+    }
+    let mut out = std::io::stdout().lock();
+    if json {
+        let doc = serde_json::json!({
+            "scene": scene.name,
+            "object": object,
+            "pusher_radius": radius,
+            "cof": slider.cof,
+            "c": slider.c,
+            "trajectory": rows,
+        });
+        serde_json::to_writer(&mut out, &doc).context("writing to stdout")?;
+        writeln!(out).context("writing to stdout")?;
+    } else {
+        writeln!(out, "t,x,y,theta,contact").context("writing to stdout")?;
+        for r in &rows {
+            writeln!(out, "{},{},{},{},{}", r.t, r.x, r.y, r.theta, r.contact)
+                .context("writing to stdout")?;
+        }
+    }
+    Ok(())
+}
+
+fn bench(scene: &str, seconds: f64) -> Result<()> {
+    use pushbot_protocol::{Command, HostFrame, MAX_FRAME, PROTOCOL_VERSION, encode_frame};
+    if !(seconds.is_finite() && seconds > 0.0) {
+        bail!("--seconds must be positive");
+    }
+    let scene = Scene::preset_or_file(scene)?;
+    let objects = scene.objects.len();
+    let mut sim = pushbot_sim::Sim::new(&SimOptions {
+        scene: Some(scene),
+        ..SimOptions::default()
+    })?;
+    let mut buf = [0u8; MAX_FRAME];
+    let mut send = |sim: &mut pushbot_sim::Sim, seq: u16, cmd: Command| -> Result<()> {
+        let n = encode_frame(&HostFrame { seq, cmd }, &mut buf)
+            .map_err(|e| anyhow::anyhow!("framing: {e}"))?;
+        sim.receive(&buf[..n]);
+        Ok(())
+    };
+    send(
+        &mut sim,
+        1,
+        Command::Hello {
+            protocol: PROTOCOL_VERSION,
+        },
+    )?;
+    let mut out = Vec::new();
+    let start = std::time::Instant::now();
+    let end_us = (seconds * 1e6) as u64;
+    let mut seq = 2u16;
+    while sim.now_us() < end_us {
+        let t = sim.now_us();
+        if t.is_multiple_of(50_000) {
+            send(&mut sim, 0, Command::Heartbeat)?;
+        }
+        if t.is_multiple_of(2_000_000) {
+            // Alternate: drive ahead (pushing), then turn, then back off.
+            let (v, omega) = match (t / 2_000_000) % 3 {
+                0 => (0.15, 0.0),
+                1 => (0.0, 2.0),
+                _ => (-0.1, 0.5),
+            };
+            send(&mut sim, seq, Command::ClearFaults)?;
+            send(
+                &mut sim,
+                seq.wrapping_add(1),
+                Command::Velocity {
+                    v,
+                    omega,
+                    timeout_ms: 2500,
+                },
+            )?;
+            seq = seq.wrapping_add(2).max(2);
+        }
+        sim.tick();
+        out.clear();
+        sim.transmit(&mut out);
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let sim_s = sim.now_us() as f64 / 1e6;
+    let doc = serde_json::json!({
+        "objects": objects,
+        "sim_s": sim_s,
+        "wall_s": wall,
+        "realtime_factor": sim_s / wall,
+        "ticks_per_s": sim_s * 1e6 / f64::from(sim.tick_us()) / wall,
+        "final_pose": sim.truth().pose,
+        "object_poses": sim.object_poses(),
+    });
+    println!("{doc}");
+    Ok(())
+}

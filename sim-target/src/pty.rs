@@ -1,0 +1,378 @@
+//! The robot's serial port on a pseudo-terminal, and [`PtySim`], the simulated robot served on
+//! it from a background thread at a chosen pace.
+//!
+//! The pty is opened with `rustix` rather than `serialport::TTYPort::pair`, which does the same
+//! `posix_openpt`/`grantpt`/`unlockpt` and `cfmakeraw` on the slave but hands back a blocking
+//! master without `AsFd`, so it cannot be made non-blocking without `unsafe`; a blocking write
+//! to a master whose slave nobody reads would stop the simulation. Here:
+//! * the slave is put in raw mode (no echo, no CR/LF translation, 8 bits, no signals);
+//! * the sim keeps the slave open itself, so the master never reads EIO while no host has it
+//!   open, and a host can close and reopen the port at will. `serialport` opens ports
+//!   exclusively (`TIOCEXCL`), and with the slave held here that flag outlives the host's close,
+//!   so the sim clears it every 20 ms of wall time: a non-root host's reopen may see `EBUSY`
+//!   for up to 20 ms (root is never refused), and exclusivity is not enforced against a second
+//!   opener;
+//! * the master is non-blocking: reads return what has arrived, writes take what fits; when the
+//!   pty is full because nobody reads it, what waits unread is discarded (like a UART overrun)
+//!   rather than blocking the robot.
+
+use std::collections::VecDeque;
+use std::fs::File;
+use std::io::{BufWriter, ErrorKind, Read, Write};
+use std::os::unix::fs::OpenOptionsExt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use rustix::event::{PollFd, PollFlags, Timespec, poll};
+use rustix::fs::OFlags;
+use rustix::pty::{OpenptFlags, grantpt, openpt, ptsname, unlockpt};
+use rustix::termios::{OptionalActions, QueueSelector, tcflush, tcgetattr, tcsetattr};
+
+use crate::faults::FaultyLink;
+use crate::sim::{Sim, SimOptions, Truth, TruthRecord};
+
+/// A pseudo-terminal pair: the master the sim reads and writes, the slave a host opens.
+pub struct Pty {
+    master: File,
+    slave: File,
+    path: String,
+}
+
+impl Pty {
+    /// Open a new pty in raw mode with a non-blocking master.
+    pub fn open() -> Result<Self> {
+        let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC)
+            .context("opening a pseudo-terminal")?;
+        grantpt(&master).context("grantpt")?;
+        unlockpt(&master).context("unlockpt")?;
+        let path = ptsname(&master, Vec::new())
+            .context("ptsname")?
+            .into_string()
+            .context("pty path is not UTF-8")?;
+        let slave = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags(OFlags::NOCTTY.bits() as i32)
+            .open(&path)
+            .with_context(|| format!("opening the pty slave {path}"))?;
+        let mut termios = tcgetattr(&slave).context("tcgetattr on the pty")?;
+        termios.make_raw();
+        tcsetattr(&slave, OptionalActions::Now, &termios).context("tcsetattr on the pty")?;
+        rustix::fs::fcntl_setfl(&master, OFlags::NONBLOCK).context("non-blocking pty master")?;
+        Ok(Pty {
+            master: File::from(master),
+            slave,
+            path,
+        })
+    }
+
+    /// Path of the slave device, e.g. `/dev/pts/7`: what a host opens as the robot's port.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// Read what has arrived from the host (0 if nothing).
+    pub fn read(&mut self, buf: &mut [u8]) -> Result<usize> {
+        loop {
+            match self.master.read(buf) {
+                Ok(n) => return Ok(n),
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) if e.kind() == ErrorKind::WouldBlock => return Ok(0),
+                // EIO: no slave open, which cannot happen while we hold one; treat as quiet.
+                Err(e) if e.raw_os_error() == Some(rustix::io::Errno::IO.raw_os_error()) => {
+                    return Ok(0);
+                }
+                Err(e) => return Err(e).context("reading the pty"),
+            }
+        }
+    }
+
+    /// Write what fits now; returns how many bytes were taken (0 if the pty is full).
+    pub fn write(&mut self, bytes: &[u8]) -> Result<usize> {
+        loop {
+            match self.master.write(bytes) {
+                Ok(n) => return Ok(n),
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) if e.kind() == ErrorKind::WouldBlock => return Ok(0),
+                Err(e) => return Err(e).context("writing the pty"),
+            }
+        }
+    }
+
+    /// Discard what was sent to the host but not read yet.
+    pub fn discard_unread(&self) -> Result<()> {
+        tcflush(&self.slave, QueueSelector::IFlush).context("flushing the pty")
+    }
+
+    /// Let any process open the port again (clears `TIOCEXCL`, which `serialport` sets).
+    pub fn allow_reopen(&self) -> Result<()> {
+        rustix::termios::ioctl_tiocnxcl(&self.slave).context("TIOCNXCL on the pty")
+    }
+
+    /// Wait until the host sent something or `timeout` passed; true if something arrived.
+    pub fn wait_readable(&self, timeout: Duration) -> Result<bool> {
+        let ts = Timespec::try_from(timeout).unwrap_or(Timespec {
+            tv_sec: 1,
+            tv_nsec: 0,
+        });
+        let mut fds = [PollFd::new(&self.master, PollFlags::IN)];
+        match poll(&mut fds, Some(&ts)) {
+            Ok(n) => Ok(n > 0),
+            Err(rustix::io::Errno::INTR) => Ok(false),
+            Err(e) => Err(e).context("polling the pty"),
+        }
+    }
+}
+
+/// Bytes queued for the host beyond which the oldest are dropped.
+const MAX_PENDING: usize = 64 * 1024;
+
+/// The simulated robot served on a pty from a background thread.
+pub struct PtySim {
+    path: String,
+    truth: Arc<Mutex<Truth>>,
+    objects: Arc<Mutex<Vec<(String, crate::Pose)>>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<Result<()>>>,
+}
+
+impl PtySim {
+    /// Build the robot, open its pty and start stepping it, paced by `opts.speed`.
+    pub fn start(opts: SimOptions) -> Result<PtySim> {
+        if !(opts.speed.is_finite() && opts.speed >= 0.0) {
+            anyhow::bail!("speed must be a finite number ≥ 0, not {}", opts.speed);
+        }
+        if !(opts.truth_hz.is_finite() && opts.truth_hz > 0.0) {
+            anyhow::bail!("truth log rate must be positive, not {}", opts.truth_hz);
+        }
+        let sim = Sim::new(&opts)?;
+        let pty = Pty::open()?;
+        let log = match &opts.truth_log {
+            Some(p) => {
+                Some(BufWriter::new(File::create(p).with_context(|| {
+                    format!("creating the truth log {}", p.display())
+                })?))
+            }
+            None => None,
+        };
+        let path = pty.path().to_owned();
+        let truth = Arc::new(Mutex::new(sim.truth()));
+        let objects = Arc::new(Mutex::new(sim.object_poses()));
+        let stop = Arc::new(AtomicBool::new(false));
+        let runner = Runner {
+            sim,
+            pty,
+            speed: opts.speed,
+            log,
+            log_period_us: ((1e6 / opts.truth_hz) as u64).max(1),
+            truth: Arc::clone(&truth),
+            objects: Arc::clone(&objects),
+            stop: Arc::clone(&stop),
+            link: opts.faults.map(|f| FaultyLink::new(f, opts.seed)),
+        };
+        let thread = std::thread::Builder::new()
+            .name("pushbot-sim".into())
+            .spawn(move || runner.run())
+            .context("starting the simulation thread")?;
+        Ok(PtySim {
+            path,
+            truth,
+            objects,
+            stop,
+            thread: Some(thread),
+        })
+    }
+
+    /// Path of the robot's serial port: open it with `serialport` as a real robot's.
+    pub fn serial_path(&self) -> &str {
+        &self.path
+    }
+
+    /// The latest true object poses (scene order, with ids).
+    pub fn objects(&self) -> Vec<(String, crate::Pose)> {
+        match self.objects.lock() {
+            Ok(o) => o.clone(),
+            Err(poisoned) => poisoned.into_inner().clone(),
+        }
+    }
+
+    /// The latest true state.
+    pub fn truth(&self) -> Truth {
+        match self.truth.lock() {
+            Ok(t) => *t,
+            Err(poisoned) => *poisoned.into_inner(),
+        }
+    }
+
+    /// Whether the simulation thread is still running (it stops on shutdown or on an I/O error,
+    /// which [`PtySim::shutdown`] then returns).
+    pub fn is_running(&self) -> bool {
+        self.thread.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
+    /// Stop the simulation and close the port; returns the error that stopped it, if any.
+    pub fn shutdown(mut self) -> Result<()> {
+        self.stop_and_join()
+    }
+
+    fn stop_and_join(&mut self) -> Result<()> {
+        self.stop.store(true, Ordering::Relaxed);
+        match self.thread.take() {
+            Some(t) => match t.join() {
+                Ok(r) => r,
+                Err(_) => Err(anyhow::anyhow!("the simulation thread panicked")),
+            },
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for PtySim {
+    fn drop(&mut self) {
+        let _ = self.stop_and_join();
+    }
+}
+
+/// The background loop's state.
+struct Runner {
+    sim: Sim,
+    pty: Pty,
+    speed: f64,
+    log: Option<BufWriter<File>>,
+    log_period_us: u64,
+    truth: Arc<Mutex<Truth>>,
+    objects: Arc<Mutex<Vec<(String, crate::Pose)>>>,
+    stop: Arc<AtomicBool>,
+    /// Fault injection between the pty and the firmware, if asked for.
+    link: Option<FaultyLink>,
+}
+
+impl Runner {
+    fn run(mut self) -> Result<()> {
+        // Sleep only when ahead of the wall clock by at least this much (bounds wake-ups).
+        const SLACK: Duration = Duration::from_millis(1);
+        // Behind by more than this, give up catching up: the sim runs slower than asked.
+        const MAX_LAG: Duration = Duration::from_millis(200);
+        let tick_us = u64::from(self.sim.tick_us());
+        let mut wall0 = Instant::now();
+        let sim0 = self.sim.now_us();
+        let mut next_log_us = sim0;
+        let mut rx = [0u8; 1024];
+        let mut tx: Vec<u8> = Vec::new();
+        let mut pending: VecDeque<u8> = VecDeque::new();
+        let mut last_nxcl = Instant::now();
+        self.log_truth(&mut next_log_us)?;
+        while !self.stop.load(Ordering::Relaxed) {
+            loop {
+                let n = self.pty.read(&mut rx)?;
+                match self.link.as_mut() {
+                    Some(link) => link.from_host(self.sim.now_us(), &rx[..n]),
+                    None => self.sim.receive(&rx[..n]),
+                }
+                if n < rx.len() {
+                    break;
+                }
+            }
+            if self.speed > 0.0 {
+                let sim_s = (self.sim.now_us() + tick_us - sim0) as f64 * 1e-6;
+                let due = wall0 + Duration::from_secs_f64(sim_s / self.speed);
+                let now = Instant::now();
+                if due > now + SLACK {
+                    // Wake early if the host sends something, to hand it over in time.
+                    self.pty
+                        .wait_readable((due - now).min(Duration::from_millis(50)))?;
+                    continue;
+                }
+                if now > due + MAX_LAG {
+                    wall0 += now - due;
+                }
+            }
+            if let Some(link) = self.link.as_mut() {
+                let mut inbound = Vec::new();
+                link.to_robot(self.sim.now_us(), &mut inbound);
+                self.sim.receive(&inbound);
+            }
+            self.sim.tick();
+            self.sim.transmit(&mut tx);
+            if let Some(link) = self.link.as_mut() {
+                let now = self.sim.now_us();
+                link.from_robot(now, &tx);
+                tx.clear();
+                link.to_host(now, &mut tx);
+            }
+            if !tx.is_empty() || !pending.is_empty() {
+                pending.extend(tx.drain(..));
+                self.send(&mut pending)?;
+            }
+            match self.truth.lock() {
+                Ok(mut t) => *t = self.sim.truth(),
+                Err(poisoned) => *poisoned.into_inner() = self.sim.truth(),
+            }
+            if !self.sim.world().objects().is_empty() {
+                let poses = self.sim.object_poses();
+                match self.objects.lock() {
+                    Ok(mut o) => *o = poses,
+                    Err(poisoned) => *poisoned.into_inner() = poses,
+                }
+            }
+            self.log_truth(&mut next_log_us)?;
+            if last_nxcl.elapsed() > Duration::from_millis(20) {
+                // A host that closed the port left it exclusive; let it (or another) reopen.
+                last_nxcl = Instant::now();
+                let _ = self.pty.allow_reopen();
+            }
+        }
+        if let Some(log) = self.log.as_mut() {
+            log.flush().context("writing the truth log")?;
+        }
+        Ok(())
+    }
+
+    /// Write pending bytes; if the pty is full (nobody reads it), discard what sits unread.
+    fn send(&mut self, pending: &mut VecDeque<u8>) -> Result<()> {
+        for attempt in 0..2 {
+            while !pending.is_empty() {
+                let (a, _) = pending.as_slices();
+                let n = self.pty.write(a)?;
+                if n == 0 {
+                    break;
+                }
+                pending.drain(..n);
+            }
+            if pending.is_empty() || attempt == 1 {
+                break;
+            }
+            self.pty.discard_unread()?;
+        }
+        if pending.len() > MAX_PENDING {
+            let excess = pending.len() - MAX_PENDING;
+            pending.drain(..excess);
+        }
+        Ok(())
+    }
+
+    fn log_truth(&mut self, next_log_us: &mut u64) -> Result<()> {
+        let Some(log) = self.log.as_mut() else {
+            return Ok(());
+        };
+        if self.sim.now_us() < *next_log_us {
+            return Ok(());
+        }
+        *next_log_us = (*next_log_us + self.log_period_us).max(self.sim.now_us());
+        let mut rec = TruthRecord::from(&self.sim.truth());
+        rec.objects = self
+            .sim
+            .world()
+            .objects()
+            .iter()
+            .map(|(_, s)| [s.pose.x, s.pose.y, s.pose.theta])
+            .collect();
+        serde_json::to_writer(&mut *log, &rec).context("writing the truth log")?;
+        log.write_all(b"\n")
+            .and_then(|()| log.flush())
+            .context("writing the truth log")
+    }
+}

@@ -1,0 +1,290 @@
+//! The simulated robot: the firmware's own [`Core`] on simulated encoders, bumper switches and
+//! motors in a [`World`], stepped at a fixed rate in simulated time.
+//!
+//! One [`Sim::tick`] is one firmware control period (1 ms for the reference robot): the sensors
+//! are read from the world at time `t`, the core computes the duties, and the world then moves
+//! for one period under those duties (a zero-order hold, as a PWM peripheral does), optionally in
+//! several physics sub-steps. Everything random is drawn from the seed, so a run is a function
+//! of the seed, the options and the bytes received at each tick.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use pushbot_firmware::{Core, Inputs, RobotParams};
+use pushbot_protocol::{Faults, Mode};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+use crate::encoder::Encoder;
+use crate::faults::LinkFaults;
+use crate::robot::{BumperSwitches, Pose};
+use crate::scene::Scene;
+use crate::world::{Body, Hardware, World};
+
+/// Everything that sets up a simulated robot.
+#[derive(Clone, Debug)]
+pub struct SimOptions {
+    /// Seed of every random draw (motor spread, slip, encoder glitches, switch bounce).
+    pub seed: u64,
+    /// Pacing of simulated time against the wall clock when served on a pty: 1 = real time,
+    /// 20 = twenty times faster, 0 = as fast as the machine goes (unpaced). Ignored in process.
+    pub speed: f64,
+    /// Where to write the truth log (JSON lines, see [`TruthRecord`]), if anywhere.
+    pub truth_log: Option<PathBuf>,
+    /// Rate of the truth log, Hz of simulated time.
+    pub truth_hz: f64,
+    /// The robot's true start pose in the table frame (its odometry starts at zero regardless).
+    pub start: Pose,
+    /// Table width (along x) and height (along y), m. The table frame has its origin at the
+    /// table's lower-left corner; the walls are its four edges.
+    pub table: (f64, f64),
+    /// The robot the firmware is built for (geometry, limits, gains).
+    pub robot: RobotParams,
+    /// The physical model's constants and noise.
+    pub hardware: Hardware,
+    /// Physics sub-steps per firmware tick.
+    pub substeps: u32,
+    /// A scene: when set, its table, obstacles, objects, robot build and robot start replace
+    /// `table`, `start` and the geometry and motor of `robot`/`hardware`.
+    pub scene: Option<Scene>,
+    /// Link faults injected between the pty and the firmware ([`crate::PtySim`] only).
+    pub faults: Option<LinkFaults>,
+}
+
+impl Default for SimOptions {
+    /// Seed 0, real time, a 1.2 m × 0.9 m table, the reference robot at its centre facing +x.
+    fn default() -> Self {
+        SimOptions {
+            seed: 0,
+            speed: 1.0,
+            truth_log: None,
+            truth_hz: 100.0,
+            start: Pose::new(0.6, 0.45, 0.0),
+            table: (1.2, 0.9),
+            robot: RobotParams::default(),
+            hardware: Hardware::default(),
+            substeps: 1,
+            scene: None,
+            faults: None,
+        }
+    }
+}
+
+/// A snapshot of the simulated robot's true state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Truth {
+    /// Simulated time, s.
+    pub t: f64,
+    /// True pose in the table frame.
+    pub pose: Pose,
+    /// Duties the firmware applied `[left, right]`.
+    pub duty: [f32; 2],
+    /// True wheel speeds `[left, right]`, rad/s.
+    pub wheel_speed: [f64; 2],
+    /// Bumper switches truly pressed (bits: 0 left, 1 centre, 2 right).
+    pub bumper: u8,
+    /// What the firmware says it is doing.
+    pub mode: Mode,
+    /// The firmware's latched faults.
+    pub faults: Faults,
+    /// The firmware's odometry pose (its own frame, starting at zero).
+    pub odometry: pushbot_protocol::Pose,
+}
+
+/// One line of the truth log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TruthRecord {
+    /// Simulated time, s.
+    pub t: f64,
+    /// True x, m (table frame).
+    pub x: f64,
+    /// True y, m.
+    pub y: f64,
+    /// True heading, rad.
+    pub theta: f64,
+    /// Duties `[left, right]`.
+    pub duty: [f32; 2],
+    /// Bumper switches truly pressed.
+    pub bumper: u8,
+    /// True object poses `[x, y, theta]` in scene order (absent without objects).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub objects: Vec<[f64; 3]>,
+}
+
+impl From<&Truth> for TruthRecord {
+    fn from(t: &Truth) -> Self {
+        TruthRecord {
+            t: t.t,
+            x: t.pose.x,
+            y: t.pose.y,
+            theta: t.pose.theta,
+            duty: t.duty,
+            bumper: t.bumper,
+            objects: Vec::new(),
+        }
+    }
+}
+
+/// The firmware core running on the simulated hardware, in process, at simulated time.
+pub struct Sim {
+    core: Core,
+    world: World,
+    encoders: [Encoder; 2],
+    switches: BumperSwitches,
+    rng: ChaCha8Rng,
+    now_us: u64,
+    tick_us: u32,
+    substeps: u32,
+    duty: [f32; 2],
+    tx: [u8; 512],
+}
+
+impl Sim {
+    /// A robot at rest at `opts.start`; its firmware has just booted (robot time 0).
+    pub fn new(opts: &SimOptions) -> Result<Self> {
+        if opts.substeps == 0 || opts.substeps > 1000 {
+            bail!("substeps must be 1..=1000, not {}", opts.substeps);
+        }
+        let (robot, hardware) = built_for(opts);
+        let body = Body::from_geometry(&robot.geometry);
+        // The world's and the sensors' noise come from separate streams of the one seed.
+        let world = match &opts.scene {
+            Some(scene) => World::from_scene(scene, body, hardware, opts.seed)?,
+            None => World::new(opts.table, opts.start, body, hardware, opts.seed)?,
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+        rng.set_stream(1);
+        let cpr = robot.geometry.encoder_cpr;
+        if cpr == 0 {
+            bail!("encoder resolution must be positive");
+        }
+        let jitter = hardware.encoder_jitter;
+        let encoders = [
+            Encoder::new(cpr, jitter, rng.random_range(-1_000_000..=1_000_000)),
+            Encoder::new(cpr, jitter, rng.random_range(-1_000_000..=1_000_000)),
+        ];
+        let core = Core::new(robot);
+        let tick_us = core.tick_period_us().max(1);
+        Ok(Sim {
+            core,
+            world,
+            encoders,
+            switches: BumperSwitches::new(hardware.bounce_us),
+            rng,
+            now_us: 0,
+            tick_us,
+            substeps: opts.substeps,
+            duty: [0.0; 2],
+            tx: [0; 512],
+        })
+    }
+
+    /// Simulated (robot) time, µs.
+    pub fn now_us(&self) -> u64 {
+        self.now_us
+    }
+
+    /// Length of one tick, µs.
+    pub fn tick_us(&self) -> u32 {
+        self.tick_us
+    }
+
+    /// Hand bytes from the host to the firmware, at the current simulated time.
+    pub fn receive(&mut self, bytes: &[u8]) {
+        if !bytes.is_empty() {
+            self.core.receive(self.now_us, bytes);
+        }
+    }
+
+    /// One firmware control period: read the sensors, step the core, move the world.
+    pub fn tick(&mut self) {
+        let angles = self.world.wheel_angles();
+        let inputs = Inputs {
+            encoder: [
+                self.encoders[0].read(angles[0], &mut self.rng),
+                self.encoders[1].read(angles[1], &mut self.rng),
+            ],
+            bumper: self
+                .switches
+                .read(self.now_us, self.world.pressed(), &mut self.rng),
+        };
+        let out = self.core.step(self.now_us, &inputs);
+        self.duty = out.duty;
+        let dt = f64::from(self.tick_us) * 1e-6 / f64::from(self.substeps);
+        for _ in 0..self.substeps {
+            self.world.step(self.duty, dt);
+        }
+        self.now_us += u64::from(self.tick_us);
+    }
+
+    /// Run whole ticks until at least `seconds` more of simulated time have passed.
+    pub fn run_for(&mut self, seconds: f64) {
+        let end = self.now_us + (seconds.max(0.0) * 1e6) as u64;
+        while self.now_us < end {
+            self.tick();
+        }
+    }
+
+    /// Append the bytes the firmware wants to send to `out`.
+    pub fn transmit(&mut self, out: &mut Vec<u8>) {
+        // Bounded, in case a core never reports an empty queue.
+        for _ in 0..1024 {
+            let n = self.core.transmit(&mut self.tx);
+            if n == 0 {
+                break;
+            }
+            out.extend_from_slice(&self.tx[..n.min(self.tx.len())]);
+        }
+    }
+
+    /// The true state now.
+    pub fn truth(&self) -> Truth {
+        Truth {
+            t: self.now_us as f64 / 1e6,
+            pose: self.world.pose(),
+            duty: self.duty,
+            wheel_speed: self.world.wheel_speeds(),
+            bumper: self.world.pressed(),
+            mode: self.core.mode(),
+            faults: self.core.faults(),
+            odometry: self.core.pose(),
+        }
+    }
+
+    /// The objects' true poses, in scene order, with their ids.
+    pub fn object_poses(&self) -> Vec<(String, Pose)> {
+        self.world
+            .objects()
+            .iter()
+            .map(|(id, s)| (id.clone(), s.pose))
+            .collect()
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The firmware core.
+    pub fn core(&self) -> &Core {
+        &self.core
+    }
+}
+
+/// The firmware parameters and hardware the options describe (a scene's robot spec wins).
+pub fn built_for(opts: &SimOptions) -> (RobotParams, Hardware) {
+    let mut robot = opts.robot;
+    let mut hw = opts.hardware;
+    if let Some(scene) = &opts.scene {
+        let r = &scene.robot;
+        robot.geometry.bumper_radius = r.bumper_radius as f32;
+        robot.geometry.wheel_base = r.wheel_base as f32;
+        robot.geometry.wheel_radius = r.wheel_radius as f32;
+        robot.geometry.encoder_cpr = r.encoder_cpr;
+        robot.gains.kff = (1.0 / r.no_load_speed) as f32;
+        hw.motor.ke = hw.motor.supply_v / r.no_load_speed;
+        hw.motor.resistance_ohm = hw.motor.ke * hw.motor.supply_v / r.stall_torque;
+    }
+    (robot, hw)
+}
