@@ -7,6 +7,9 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+pub mod robot;
+pub mod strategy;
+
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
 pub struct Global {
@@ -33,7 +36,16 @@ pub struct Cli {
 
 /// The commands.
 #[derive(Subcommand, Debug)]
-pub enum Command {}
+pub enum Command {
+    /// Talk to the robot: info, move, spin, stop, estop, clear-faults.
+    Robot(robot::RobotArgs),
+    /// Collect a pushing strategy for an object (Lau et al. Algorithm 1), in simulation.
+    Collect(strategy::CollectArgs),
+    /// Evaluate: `eval delivery` (Lau et al. Fig. 11, learned vs dipole).
+    Eval(strategy::EvalArgs),
+    /// Benchmarks: `bench knn`.
+    Bench(strategy::BenchArgs),
+}
 
 /// How a command that ran to its end went.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,6 +114,10 @@ fn init_logging(verbose: u8) {
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
-    let _ = &global;
-    match command {}
+    match command {
+        Command::Robot(args) => robot::run(&global, args),
+        Command::Collect(args) => strategy::run_collect(&global, args),
+        Command::Eval(args) => strategy::run_eval(&global, args),
+        Command::Bench(args) => strategy::run_bench(&global, args),
+    }
 }

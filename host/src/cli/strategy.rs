@@ -1,0 +1,448 @@
+//! `pushbot collect`, `pushbot eval delivery` and `pushbot bench knn`: the learned pushing
+//! strategy of Lau, Mitani & Igarashi (collection, Algorithm 1; delivery, Algorithm 2) and the
+//! dipole-field baseline, run in the in-process simulation.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pushbot_sim::Scene;
+use serde_json::json;
+
+use super::{CliError, CliResult, Global, Status};
+use crate::strategy::collect::{CollectParams, CollectReport, collect};
+use crate::strategy::deliver::DeliveryParams;
+use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start};
+use crate::strategy::figures;
+use crate::strategy::regression::{KernelParams, PushStrategy};
+use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
+use crate::strategy::sample::Sample;
+use crate::strategy::store::{self, StrategyWriter};
+
+/// Settings shared by collection and evaluation.
+#[derive(Args, Debug, Clone)]
+pub struct SimArgs {
+    /// Camera position noise (standard deviation), mm.
+    #[arg(long, default_value_t = 1.0)]
+    pub noise_mm: f64,
+    /// Camera heading noise (standard deviation), degrees.
+    #[arg(long, default_value_t = 0.5)]
+    pub noise_deg: f64,
+    /// How far inside the table edge the object's boundary lies, m.
+    #[arg(long, default_value_t = 0.2)]
+    pub boundary_inset: f64,
+    /// Kernel width K_w of the regression, m (the paper: 8 px ≈ 1.8 cm).
+    #[arg(long, default_value_t = 0.018)]
+    pub kernel_width: f64,
+    /// Neighbours k of the regression.
+    #[arg(long, default_value_t = 5)]
+    pub k: usize,
+}
+
+impl SimArgs {
+    fn options(&self, seed: u64) -> Result<SimRobotOptions, CliError> {
+        let ok = |v: f64| v.is_finite() && v >= 0.0;
+        if !ok(self.noise_mm) || !ok(self.noise_deg) || !ok(self.boundary_inset) {
+            return Err(CliError::bad_input(
+                "noise and boundary inset must be finite and not negative",
+            ));
+        }
+        Ok(SimRobotOptions {
+            seed,
+            position_noise: self.noise_mm * 1e-3,
+            heading_noise: self.noise_deg.to_radians(),
+            boundary_inset: self.boundary_inset,
+            ..SimRobotOptions::default()
+        })
+    }
+
+    fn kernel(&self) -> Result<KernelParams, CliError> {
+        if !(self.kernel_width.is_finite() && self.kernel_width > 0.0) || self.k == 0 {
+            return Err(CliError::bad_input(
+                "the kernel width must be positive and k at least 1",
+            ));
+        }
+        Ok(KernelParams {
+            k: self.k,
+            kernel_width: self.kernel_width,
+        })
+    }
+}
+
+/// `pushbot collect`: collect a pushing strategy (Algorithm 1) in the simulation.
+#[derive(Args, Debug)]
+pub struct CollectArgs {
+    /// The object: one of Lau et al.'s six (irregular, irregular-corner, l-shape, wire-cutter,
+    /// scissors, snake; scene `lau-<object>`), or an object id of `--scene`.
+    #[arg(long)]
+    pub object: String,
+    /// Scene preset or file (default: `lau-<object>`).
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// Strategy file to append to (default: `<object>.strategy`); an existing file is resumed.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// K: samples of the initial collection.
+    #[arg(long, default_value_t = 300)]
+    pub initial: usize,
+    /// Stop the evaluation after this many straight successful queries.
+    #[arg(long, default_value_t = 10)]
+    pub streak: usize,
+    /// Give up the evaluation after this many queries.
+    #[arg(long, default_value_t = 80)]
+    pub max_queries: usize,
+    /// Write the strategy as an SVG (Fig. 7 style).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub sim: SimArgs,
+}
+
+/// `pushbot eval`: evaluations.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// What to evaluate.
+    #[command(subcommand)]
+    pub cmd: EvalCmd,
+}
+
+/// The evaluations.
+#[derive(Subcommand, Debug)]
+pub enum EvalCmd {
+    /// Deliver the object from named start positions to the goal (Lau et al. Fig. 10–11).
+    Delivery(DeliveryArgs),
+}
+
+/// Which delivery methods to run.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MethodArg {
+    /// The learned pushing strategy.
+    Learned,
+    /// The dipole-field baseline.
+    Dipole,
+    /// Both, side by side.
+    Both,
+}
+
+/// `pushbot eval delivery`.
+#[derive(Args, Debug)]
+pub struct DeliveryArgs {
+    /// Scene preset or file (e.g. lau-irregular).
+    #[arg(long)]
+    pub scene: String,
+    /// Object id in the scene (default: the first).
+    #[arg(long)]
+    pub object: Option<String>,
+    /// Method(s).
+    #[arg(long, value_enum, default_value_t = MethodArg::Both)]
+    pub method: MethodArg,
+    /// Start positions: A..F, A,C or B.
+    #[arg(long, default_value = "A..F")]
+    pub start: String,
+    /// Trials per start position and method.
+    #[arg(long, default_value_t = 10)]
+    pub trials: usize,
+    /// Pushing strategy file; without it one is collected in the simulation first.
+    #[arg(long)]
+    pub strategy: Option<PathBuf>,
+    /// K of the collection when no strategy file is given.
+    #[arg(long, default_value_t = 300)]
+    pub initial: usize,
+    /// Time limit of one trial, s of simulated time (the paper: 8 minutes).
+    #[arg(long, default_value_t = 480.0)]
+    pub time_limit: f64,
+    /// Run on the robot through the serial port and the camera (not available yet).
+    #[arg(long)]
+    pub hil: bool,
+    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub sim: SimArgs,
+}
+
+/// `pushbot bench`: benchmarks.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Which benchmark.
+    #[command(subcommand)]
+    pub cmd: BenchCmd,
+}
+
+/// The benchmarks of this module.
+#[derive(Subcommand, Debug)]
+pub enum BenchCmd {
+    /// k-NN regression query time at a strategy size.
+    Knn {
+        /// Samples in the strategy.
+        #[arg(long, default_value_t = 100_000)]
+        samples: usize,
+        /// Queries timed.
+        #[arg(long, default_value_t = 2_000)]
+        queries: usize,
+    },
+}
+
+fn progress_bar(global: &Global, len: u64) -> ProgressBar {
+    if global.json || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{elapsed_precise} samples {pos} {wide_bar} {msg}")
+    {
+        pb.set_style(style);
+    }
+    pb
+}
+
+fn scene_for(object: &str, scene: Option<&str>) -> Result<(Scene, Option<String>), CliError> {
+    let (name, id) = match scene {
+        Some(s) => (s.to_owned(), Some(object.to_owned())),
+        None => (format!("lau-{object}"), None),
+    };
+    let scene = Scene::preset_or_file(&name).map_err(|e| CliError::bad_input(e.to_string()))?;
+    Ok((scene, id))
+}
+
+/// Collect in the simulation into `writer`'s file, starting from `existing` samples.
+fn collect_in_sim(
+    global: &Global,
+    scene: Scene,
+    object: Option<&str>,
+    sim: &SimArgs,
+    params: &CollectParams,
+    existing: Vec<Sample>,
+    writer: Option<&mut StrategyWriter>,
+) -> Result<(PushStrategy, CollectReport), CliError> {
+    let mut io = SimRobot::new(scene, object, None, sim.options(global.seed)?)
+        .map_err(CliError::BadInput)?;
+    let mut strategy = PushStrategy::new(existing, sim.kernel()?);
+    let pb = progress_bar(global, params.initial as u64);
+    let mut w = writer;
+    let mut sink = |s: &Sample| -> anyhow::Result<()> {
+        if let Some(w) = w.as_deref_mut() {
+            w.append(s)?;
+        }
+        Ok(())
+    };
+    let rep = collect(&mut io, &mut strategy, params, &mut sink, &pb)?;
+    pb.finish_and_clear();
+    Ok((strategy, rep))
+}
+
+/// Run `pushbot collect`.
+pub fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
+    let (scene, id) = scene_for(&a.object, a.scene.as_deref())?;
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.strategy", a.object)));
+    let (mut writer, existing) =
+        StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
+    let had = existing.len();
+    let params = CollectParams {
+        initial: a.initial,
+        streak: a.streak,
+        max_queries: a.max_queries,
+        seed: global.seed,
+        ..CollectParams::default()
+    };
+    let outline = object_outline(&scene, id.as_deref());
+    let (strategy, rep) = collect_in_sim(
+        global,
+        scene,
+        id.as_deref(),
+        &a.sim,
+        &params,
+        existing,
+        Some(&mut writer),
+    )?;
+    if let Some(svg) = &a.svg {
+        std::fs::write(svg, figures::strategy_svg(strategy.samples(), &outline))
+            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
+    }
+    if global.json {
+        println!(
+            "{}",
+            json!({"object": a.object, "file": out, "samples_before": had, "report": rep})
+        );
+    } else {
+        println!(
+            "{}: {} samples ({} initial, {} supplemental, {} before) in {:.1} simulated min \
+             ({:.1} initial); queries {} ok {}; {} straight successes {}",
+            a.object,
+            rep.total_samples,
+            rep.initial_samples,
+            rep.supplemental_samples,
+            had,
+            rep.total_minutes,
+            rep.initial_minutes,
+            rep.queries,
+            rep.successes,
+            a.streak,
+            if rep.streak_reached {
+                "reached"
+            } else {
+                "NOT reached"
+            },
+        );
+        println!("written to {}", out.display());
+    }
+    Ok(if rep.streak_reached || a.streak == 0 {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
+}
+
+/// The object's outline relative to its marker (for figures).
+fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
+    let obj = match id {
+        Some(id) => scene.object(id),
+        None => scene.objects.first(),
+    };
+    obj.map(|o| {
+        let m = o.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+        o.outline
+            .iter()
+            .map(|v| [v[0] - m[0], v[1] - m[1]])
+            .collect()
+    })
+    .unwrap_or_default()
+}
+
+/// Run `pushbot eval`.
+pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
+    let EvalCmd::Delivery(a) = a.cmd;
+    if a.hil {
+        return Err(CliError::bad_input(
+            "--hil (serial link and camera) is not implemented yet; run without it for the \
+             in-process simulation",
+        ));
+    }
+    if !(a.time_limit.is_finite() && a.time_limit > 0.0) {
+        return Err(CliError::bad_input("--time-limit must be positive"));
+    }
+    let starts = parse_starts(&a.start).map_err(CliError::bad_input)?;
+    let scene = Scene::preset_or_file(&a.scene).map_err(|e| CliError::bad_input(e.to_string()))?;
+    for s in &starts {
+        if scene.position(s).is_none() {
+            return Err(CliError::bad_input(format!(
+                "scene {} has no start position {s}",
+                scene.name
+            )));
+        }
+    }
+    let methods: Vec<Method> = match a.method {
+        MethodArg::Learned => vec![Method::Learned],
+        MethodArg::Dipole => vec![Method::Dipole],
+        MethodArg::Both => vec![Method::Learned, Method::Dipole],
+    };
+    let setup = TrialSetup {
+        scene: scene.clone(),
+        object: a.object.clone(),
+        sim: a.sim.options(global.seed)?,
+        delivery: DeliveryParams {
+            time_limit: a.time_limit,
+            ..DeliveryParams::default()
+        },
+        kernel: a.sim.kernel()?,
+    };
+    setup.goal().map_err(CliError::BadInput)?;
+    // The strategy: from a file, or collected here first.
+    let mut collection = None;
+    let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
+        Vec::new()
+    } else if let Some(path) = &a.strategy {
+        store::load(path)
+            .map_err(|e| CliError::bad_input(e.to_string()))?
+            .samples
+    } else {
+        let params = CollectParams {
+            initial: a.initial,
+            seed: global.seed,
+            ..CollectParams::default()
+        };
+        let (strat, rep) = collect_in_sim(
+            global,
+            scene.clone(),
+            a.object.as_deref(),
+            &a.sim,
+            &params,
+            Vec::new(),
+            None,
+        )?;
+        collection = Some(rep);
+        strat.samples().to_vec()
+    };
+    let mut results: Vec<StartResult> = Vec::new();
+    let mut trajectories = Vec::new();
+    for s in &starts {
+        for &m in &methods {
+            let (res, runs) = run_start(&setup, m, &samples, s, a.trials)?;
+            if let Some(first) = runs.into_iter().next() {
+                trajectories.push((format!("{s} {m:?}"), first.trajectory));
+            }
+            if !global.json {
+                println!(
+                    "{} {:>7}: {:>5.1} % of {} | time {} | object path {}",
+                    res.start,
+                    format!("{m:?}"),
+                    res.success_rate,
+                    res.trials,
+                    res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
+                    res.mean_object_path_m
+                        .map_or("-".into(), |t| format!("{t:.2} m")),
+                );
+            }
+            results.push(res);
+        }
+    }
+    if let Some(svg) = &a.svg {
+        let goal = setup.goal().map_err(CliError::BadInput)?;
+        let text = figures::trajectories_svg(&trajectories, &scene, goal);
+        std::fs::write(svg, text)
+            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
+    }
+    let learned_ok = results
+        .iter()
+        .filter(|r| r.method == Method::Learned)
+        .all(|r| r.success_rate >= 95.0);
+    if global.json {
+        println!(
+            "{}",
+            json!({
+                "scene": scene.name,
+                "samples": samples.len(),
+                "collection": collection,
+                "results": results,
+            })
+        );
+    }
+    Ok(if learned_ok {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
+}
+
+/// Run `pushbot bench`.
+pub fn run_bench(global: &Global, a: BenchArgs) -> CliResult {
+    let BenchCmd::Knn { samples, queries } = a.cmd;
+    if samples == 0 || queries == 0 {
+        return Err(CliError::bad_input("samples and queries must be positive"));
+    }
+    let r = crate::strategy::bench::run(samples, queries, global.seed);
+    if global.json {
+        println!("{}", json!(r));
+    } else {
+        println!(
+            "{} samples: build {:.1} ms, general {:.2} µs, special {:.2} µs, linear {:.1} µs \
+             per query",
+            r.samples, r.build_ms, r.general_us, r.special_us, r.linear_us
+        );
+    }
+    Ok(Status::Success)
+}

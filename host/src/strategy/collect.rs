@@ -1,0 +1,283 @@
+//! Collecting the pushing strategy: Lau, Mitani & Igarashi §III-C (initial data collection)
+//! and §III-D (experimental evaluation of existing data), Algorithm 1.
+//!
+//! Initial collection: K times, spin by a random angle and drive forward a random distance,
+//! saving each push that moved the object as a sample; `reset_robot` (face the marker and
+//! creep forward until the object moves) when a push did not move the object, and
+//! `reset_robot_obj_boundary` (around the bound-all circle to the push-point, then push the
+//! object back in; Fig. 3) when the object left the boundary. Experimental evaluation: solve
+//! random goal queries with the data so far, adding each push as a supplemental sample used at
+//! once, until the last `streak` queries all succeeded.
+
+use anyhow::Result;
+use indicatif::ProgressBar;
+use nalgebra::Vector2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::deliver::{
+    DeliveryParams, Failure, bound_all_radius, circle_walk, deliver_learned, face,
+};
+use super::regression::PushStrategy;
+use super::robot_io::RobotIo;
+use super::sample::Sample;
+
+/// Parameters of Algorithm 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CollectParams {
+    /// K: samples of the initial collection.
+    pub initial: usize,
+    /// Largest random spin of a push, rad (either way).
+    pub spin_max: f64,
+    /// Shortest random push, m.
+    pub push_min: f64,
+    /// Longest random push, m.
+    pub push_max: f64,
+    /// ε: the object moved if its marker moved at least this far, m.
+    pub epsilon: f64,
+    /// Evaluation stops after this many straight successful queries (the paper: 10).
+    pub streak: usize,
+    /// Evaluation gives up after this many queries.
+    pub max_queries: usize,
+    /// Random goals are at least this far from the object, m.
+    pub goal_min_distance: f64,
+    /// Delivery parameters of the evaluation's queries (its time limit is over_time_limit()).
+    pub delivery: DeliveryParams,
+    /// Seed of the random pushes and goals.
+    pub seed: u64,
+}
+
+impl Default for CollectParams {
+    fn default() -> Self {
+        CollectParams {
+            initial: 300,
+            spin_max: 75f64.to_radians(),
+            push_min: 0.02,
+            push_max: 0.08,
+            epsilon: 0.004,
+            streak: 10,
+            max_queries: 80,
+            goal_min_distance: 0.25,
+            delivery: DeliveryParams {
+                time_limit: 240.0,
+                ..DeliveryParams::default()
+            },
+            seed: 1,
+        }
+    }
+}
+
+/// What a collection run did.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct CollectReport {
+    /// Samples from the initial collection.
+    pub initial_samples: usize,
+    /// Supplemental samples from the evaluation's queries.
+    pub supplemental_samples: usize,
+    /// Samples in the strategy at the end (including any loaded before).
+    pub total_samples: usize,
+    /// Pushes of the initial collection that did not move the object (each led to reset_robot).
+    pub misses: usize,
+    /// Times reset_robot_obj_boundary ran.
+    pub boundary_resets: usize,
+    /// Goal queries solved or tried.
+    pub queries: usize,
+    /// Successful queries.
+    pub successes: usize,
+    /// Whether the last `streak` queries all succeeded.
+    pub streak_reached: bool,
+    /// Simulated (or real) minutes of the initial collection.
+    pub initial_minutes: f64,
+    /// Minutes of the whole run.
+    pub total_minutes: f64,
+}
+
+/// `reset_robot()`: spin to face the object's marker and creep forward until the object moves.
+/// Returns whether it moved.
+pub fn reset_robot(io: &mut dyn RobotIo, epsilon: f64) -> Result<bool> {
+    let o0 = io.object_pose();
+    let r0 = io.robot_pose();
+    let budget = (o0.position() - r0.position()).norm() + 0.15;
+    let mut travelled = 0.0;
+    let creep = 0.015;
+    while travelled < budget {
+        let r = io.robot_pose();
+        let o = io.object_pose();
+        let d = o.position() - r.position();
+        face(io, d.y.atan2(d.x), 0.05)?;
+        io.forward(creep)?;
+        travelled += creep;
+        if (io.object_pose().position() - o0.position()).norm() >= epsilon {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+/// `reset_robot_obj_boundary()` (Fig. 3): the object's marker is outside the boundary; move the
+/// robot around the bound-all circle to the push-point (where the vector to the object's centre
+/// is perpendicular to the boundary, pointing inside) and push the object back in. Returns
+/// whether the marker is inside the boundary again.
+pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64) -> Result<bool> {
+    let ws = io.workspace();
+    let radius = bound_all_radius(&ws, margin);
+    let reach = ws.reachable();
+    let target = ws.boundary.inset(0.04);
+    for _round in 0..4 {
+        let o = io.object_pose();
+        let Some(n) = ws.boundary.outward(o.position()) else {
+            return Ok(true);
+        };
+        // The push-point, or the reachable point of the circle nearest to it.
+        let base = n.y.atan2(n.x);
+        let at = |a: f64| o.position() + radius * Vector2::new(a.cos(), a.sin());
+        let push_angle = (0..=36)
+            .flat_map(|k| {
+                let d = f64::from(k) * 5f64.to_radians();
+                [base + d, base - d]
+            })
+            .find(|a| reach.contains(at(*a)))
+            .unwrap_or(base);
+        circle_walk(io, o.position(), radius, push_angle, 0.05)?;
+        // (d) Push towards the object until it is back inside.
+        let mut still = 0;
+        for _ in 0..30 {
+            let o = io.object_pose();
+            if target.contains(o.position()) {
+                return Ok(true);
+            }
+            let r = io.robot_pose();
+            // Aim at the marker, pulled a little towards the table's centre.
+            let aim = o.position() + 0.03 * (ws.boundary.centre() - o.position()).normalize();
+            let d = aim - r.position();
+            face(io, d.y.atan2(d.x), 0.05)?;
+            io.forward(0.03)?;
+            if (io.object_pose().position() - o.position()).norm() < epsilon {
+                still += 1;
+                if still >= 2 {
+                    break;
+                }
+            } else {
+                still = 0;
+            }
+        }
+        if ws.boundary.contains(io.object_pose().position()) {
+            return Ok(true);
+        }
+    }
+    Ok(ws.boundary.contains(io.object_pose().position()))
+}
+
+fn outside(io: &mut dyn RobotIo) -> bool {
+    let ws = io.workspace();
+    !ws.boundary.contains(io.object_pose().position())
+}
+
+fn random_goal(io: &mut dyn RobotIo, rng: &mut ChaCha8Rng, min_dist: f64) -> Vector2<f64> {
+    let ws = io.workspace();
+    let area = ws.boundary.inset(0.05);
+    let o = io.object_pose().position();
+    let mut best = area.centre();
+    for _ in 0..100 {
+        let g = Vector2::new(
+            rng.random_range(area.min[0]..=area.max[0]),
+            rng.random_range(area.min[1]..=area.max[1]),
+        );
+        best = g;
+        if (g - o).norm() >= min_dist {
+            break;
+        }
+    }
+    best
+}
+
+fn progress(pb: &ProgressBar, strategy: &PushStrategy, rep: &CollectReport, t: f64) {
+    pb.set_position(strategy.len() as u64);
+    pb.set_message(format!(
+        "queries {} ok {} | {:.1} sim min",
+        rep.queries,
+        rep.successes,
+        t / 60.0
+    ));
+}
+
+/// Run Algorithm 1 on `io`: the initial collection, then the experimental evaluation. Each new
+/// sample is added to `strategy` and passed to `sink` (to be stored) as it is made.
+pub fn collect(
+    io: &mut dyn RobotIo,
+    strategy: &mut PushStrategy,
+    params: &CollectParams,
+    sink: &mut dyn FnMut(&Sample) -> Result<()>,
+    pb: &ProgressBar,
+) -> Result<CollectReport> {
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let t0 = io.time();
+    let margin = params.delivery.bound_all_margin;
+    let mut rep = CollectReport::default();
+
+    // Initial data collection.
+    let mut moved_last = false;
+    let mut attempts = 0;
+    while rep.initial_samples < params.initial && attempts < 8 * params.initial.max(1) {
+        attempts += 1;
+        if !moved_last {
+            reset_robot(io, params.epsilon)?;
+        }
+        if outside(io) {
+            rep.boundary_resets += 1;
+            reset_robot_obj_boundary(io, margin, params.epsilon)?;
+        }
+        let angle = rng.random_range(-params.spin_max..=params.spin_max);
+        io.spin(angle)?;
+        let (r0, o0) = (io.robot_pose(), io.object_pose());
+        io.forward(rng.random_range(params.push_min..=params.push_max))?;
+        let (r1, o1) = (io.robot_pose(), io.object_pose());
+        moved_last = (o1.position() - o0.position()).norm() >= params.epsilon;
+        if moved_last {
+            let s = Sample::from_push(r0, r1, o0, o1);
+            strategy.add(s);
+            sink(&s)?;
+            rep.initial_samples += 1;
+        } else {
+            rep.misses += 1;
+        }
+        progress(pb, strategy, &rep, io.time() - t0);
+    }
+    rep.initial_minutes = (io.time() - t0) / 60.0;
+
+    // Experimental evaluation of existing data.
+    let mut streak = 0;
+    let mut needs_reset = true;
+    while rep.queries < params.max_queries && params.streak > 0 {
+        if needs_reset {
+            reset_robot(io, params.epsilon)?;
+        }
+        if outside(io) {
+            rep.boundary_resets += 1;
+            reset_robot_obj_boundary(io, margin, params.epsilon)?;
+        }
+        let goal = random_goal(io, &mut rng, params.goal_min_distance);
+        let mut added = 0;
+        let d = deliver_learned(io, strategy, goal, &params.delivery, &mut |s| {
+            added += 1;
+            sink(s)
+        })?;
+        rep.supplemental_samples += added;
+        rep.queries += 1;
+        if d.success {
+            rep.successes += 1;
+            streak += 1;
+        } else {
+            streak = 0;
+        }
+        needs_reset = matches!(d.failure, Some(Failure::TimeLimit));
+        progress(pb, strategy, &rep, io.time() - t0);
+        if streak >= params.streak {
+            rep.streak_reached = true;
+            break;
+        }
+    }
+    rep.total_samples = strategy.len();
+    rep.total_minutes = (io.time() - t0) / 60.0;
+    Ok(rep)
+}

@@ -1,0 +1,362 @@
+//! Object delivery (Lau, Mitani & Igarashi §III-E, Algorithm 2) and the dipole-field baseline
+//! (§V, Fig. 10–11), both on a [`RobotIo`].
+//!
+//! Learned delivery repeats: observe robot and object; if the object's marker is within 2.2 cm
+//! of the goal, succeed; if the object leaves the boundary, the robot leaves the table or time
+//! runs out, fail. Otherwise ask the pushing strategy: in the *general case* for the push
+//! direction r from the robot's current position p and the wanted object motion s (the goal
+//! direction scaled by `offset`); in the *special case* — the last push moved the object away
+//! from the goal (or did not move it: the robot lost contact) — for both the position p to push
+//! from and the direction r, and move there around the object's bound-all circle (Fig. 3, 4b).
+//! Motion is two-level (§IV): spins are corrected once at a finer level, and pushes are long
+//! (coarse) far from the goal and short (fine) near it. Every push is a supplemental sample
+//! (§III-D), handed to a sink and usable at once.
+
+use anyhow::Result;
+use nalgebra::Vector2;
+
+use super::dipole::{self, DipoleCommand, DipoleParams};
+use super::regression::PushStrategy;
+use super::robot_io::{RobotIo, Workspace};
+use super::sample::{Pose2, Sample, wrap_angle};
+
+/// Parameters of delivery.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeliveryParams {
+    /// Success: the object's marker within this distance of the goal, m (the paper: 2.2 cm).
+    pub success_radius: f64,
+    /// Failure when not delivered within this time, s (the paper: 8 minutes).
+    pub time_limit: f64,
+    /// Coarse push length, m.
+    pub coarse_step: f64,
+    /// Fine push length, m.
+    pub fine_step: f64,
+    /// Object–goal distance below which pushes are fine, m.
+    pub fine_radius: f64,
+    /// Heading error left after a coarse spin that a fine spin corrects, rad.
+    pub heading_tolerance: f64,
+    /// The object moved if its marker moved at least this far, m.
+    pub moved_epsilon: f64,
+    /// Extra space of the bound-all circle beyond the robot's and the object's radii, m.
+    pub bound_all_margin: f64,
+    /// Dipole baseline: length of one drive step, s.
+    pub dipole_step: f64,
+    /// Dipole baseline: controller parameters.
+    pub dipole: DipoleParams,
+}
+
+impl Default for DeliveryParams {
+    fn default() -> Self {
+        DeliveryParams {
+            success_radius: 0.022,
+            time_limit: 480.0,
+            coarse_step: 0.04,
+            fine_step: 0.015,
+            fine_radius: 0.1,
+            heading_tolerance: 0.05,
+            moved_epsilon: 0.003,
+            bound_all_margin: 0.02,
+            dipole_step: 0.25,
+            dipole: DipoleParams::default(),
+        }
+    }
+}
+
+/// Why a delivery failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Failure {
+    /// The object's marker left the boundary.
+    ObjectLeftBoundary,
+    /// The robot reached the table's edge.
+    RobotLeftBoundary,
+    /// Not delivered within the time limit.
+    TimeLimit,
+    /// The strategy had no answer (no samples).
+    NoStrategy,
+}
+
+/// How one delivery went.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Delivery {
+    /// Whether the object reached the goal.
+    pub success: bool,
+    /// Why not, if not.
+    pub failure: Option<Failure>,
+    /// Time taken, s.
+    pub time: f64,
+    /// Pushes made (learned) or commands sent (dipole).
+    pub steps: usize,
+    /// Times the robot re-positioned itself (special case).
+    pub repositions: usize,
+    /// Path length of the object's marker, m.
+    pub object_path: f64,
+    /// Path length of the robot, m.
+    pub robot_path: f64,
+    /// Final marker–goal distance, m.
+    pub final_distance: f64,
+    /// Robot and object poses after every step (Fig. 8).
+    #[serde(skip)]
+    pub trajectory: Vec<(Pose2, Pose2)>,
+}
+
+/// Radius of the bound-all circle (Fig. 3): object bounding radius + robot radius + margin.
+pub fn bound_all_radius(ws: &Workspace, margin: f64) -> f64 {
+    ws.object_radius + ws.robot_radius + margin
+}
+
+fn angle_of(v: Vector2<f64>) -> f64 {
+    v.y.atan2(v.x)
+}
+
+/// Spin to `heading`, then once more at the finer level if still off by more than `tol`.
+pub fn face(io: &mut dyn RobotIo, heading: f64, tol: f64) -> Result<()> {
+    let r = io.robot_pose();
+    io.spin(wrap_angle(heading - r.theta))?;
+    let r = io.robot_pose();
+    let err = wrap_angle(heading - r.theta);
+    if err.abs() > tol {
+        io.spin(err)?;
+    }
+    Ok(())
+}
+
+/// Drive to `target`: face it and drive there (coarse), then correct once (fine).
+pub fn go_to(io: &mut dyn RobotIo, target: Vector2<f64>, tol: f64) -> Result<()> {
+    for _ in 0..2 {
+        let r = io.robot_pose();
+        let d = target - r.position();
+        if d.norm() < 0.005 {
+            break;
+        }
+        face(io, angle_of(d), tol)?;
+        io.forward(d.norm())?;
+    }
+    Ok(())
+}
+
+/// Move the robot around the circle of radius `radius` about `centre` (Fig. 3 a–c): first to
+/// the circle's closest point, then along it in chords of at most 30° to the point at angle
+/// `to`, going the way that keeps the robot on the table (points the robot cannot reach are
+/// pulled back onto the table).
+pub fn circle_walk(
+    io: &mut dyn RobotIo,
+    centre: Vector2<f64>,
+    radius: f64,
+    to: f64,
+    tol: f64,
+) -> Result<()> {
+    let reach = io.workspace().reachable();
+    let clamp = |p: Vector2<f64>| {
+        Vector2::new(
+            p.x.clamp(reach.min[0], reach.max[0]),
+            p.y.clamp(reach.min[1], reach.max[1]),
+        )
+    };
+    let on = |a: f64| centre + radius * Vector2::new(a.cos(), a.sin());
+    let r = io.robot_pose();
+    let rel = r.position() - centre;
+    let from = if rel.norm() > 1e-9 {
+        angle_of(rel)
+    } else {
+        r.theta + std::f64::consts::PI
+    };
+    if rel.norm() < radius {
+        // Back straight away from the centre onto the circle.
+        face(io, angle_of(-rel), tol)?;
+        let back = clamp(on(from)) - io.robot_pose().position();
+        io.forward(-back.norm())?;
+    } else {
+        go_to(io, clamp(on(from)), tol)?;
+    }
+    let delta = wrap_angle(to - from);
+    let other = if delta >= 0.0 {
+        delta - std::f64::consts::TAU
+    } else {
+        delta + std::f64::consts::TAU
+    };
+    let route = |d: f64| -> Vec<f64> {
+        let n = (d.abs() / 30f64.to_radians()).ceil().max(1.0) as usize;
+        (1..=n).map(|i| from + d * i as f64 / n as f64).collect()
+    };
+    let blocked = |pts: &[f64]| pts.iter().filter(|a| !reach.contains(on(**a))).count();
+    let (a, b) = (route(delta), route(other));
+    let pts = if blocked(&a) <= blocked(&b) { a } else { b };
+    for ang in pts {
+        go_to(io, clamp(on(ang)), tol)?;
+    }
+    Ok(())
+}
+
+fn path_len(traj: &[(Pose2, Pose2)], pick: fn(&(Pose2, Pose2)) -> Pose2) -> f64 {
+    traj.windows(2)
+        .map(|w| (pick(&w[1]).position() - pick(&w[0]).position()).norm())
+        .sum()
+}
+
+/// The checks every delivery loop makes each step: success or one of the failures.
+fn verdict(
+    io: &mut dyn RobotIo,
+    o: &Pose2,
+    r: &Pose2,
+    goal: Vector2<f64>,
+    start: f64,
+    p: &DeliveryParams,
+) -> Option<Result<(), Failure>> {
+    let ws = io.workspace();
+    if (goal - o.position()).norm() < p.success_radius {
+        return Some(Ok(()));
+    }
+    if !ws.boundary.contains(o.position()) {
+        return Some(Err(Failure::ObjectLeftBoundary));
+    }
+    if !ws
+        .table
+        .inset(ws.robot_radius + 0.002)
+        .contains(r.position())
+    {
+        return Some(Err(Failure::RobotLeftBoundary));
+    }
+    if io.time() - start > p.time_limit {
+        return Some(Err(Failure::TimeLimit));
+    }
+    None
+}
+
+fn finish(
+    io: &mut dyn RobotIo,
+    start: f64,
+    goal: Vector2<f64>,
+    outcome: Result<(), Failure>,
+    steps: usize,
+    repositions: usize,
+    trajectory: Vec<(Pose2, Pose2)>,
+) -> Delivery {
+    let o = io.object_pose();
+    Delivery {
+        success: outcome.is_ok(),
+        failure: outcome.err(),
+        time: io.time() - start,
+        steps,
+        repositions,
+        object_path: path_len(&trajectory, |t| t.1),
+        robot_path: path_len(&trajectory, |t| t.0),
+        final_distance: (goal - o.position()).norm(),
+        trajectory,
+    }
+}
+
+/// Deliver the object to `goal` with the pushing strategy (Algorithm 2). Every push with an
+/// object motion of at least `moved_epsilon` is added to `strategy` at once and passed to
+/// `sink` (to be stored).
+pub fn deliver_learned(
+    io: &mut dyn RobotIo,
+    strategy: &mut PushStrategy,
+    goal: Vector2<f64>,
+    p: &DeliveryParams,
+    sink: &mut dyn FnMut(&Sample) -> Result<()>,
+) -> Result<Delivery> {
+    let start = io.time();
+    let ws = io.workspace();
+    let bound_all = bound_all_radius(&ws, p.bound_all_margin);
+    let mut traj = Vec::new();
+    let (mut steps, mut repositions) = (0, 0);
+    let mut special = {
+        let (r, o) = (io.robot_pose(), io.object_pose());
+        (r.position() - o.position()).norm() > bound_all
+    };
+    loop {
+        let (r, o) = (io.robot_pose(), io.object_pose());
+        traj.push((r, o));
+        if let Some(v) = verdict(io, &o, &r, goal, start, p) {
+            return Ok(finish(io, start, goal, v, steps, repositions, traj));
+        }
+        let to_goal = goal - o.position();
+        let dist = to_goal.norm();
+        let want = o.vector_to_local(to_goal / dist);
+        let want = [want.x, want.y];
+        let step = if dist > p.fine_radius {
+            p.coarse_step
+        } else {
+            (0.8 * dist).clamp(0.006, p.fine_step)
+        };
+        let dir_world = if special {
+            let Some(rep) = strategy.special(want) else {
+                return Ok(finish(
+                    io,
+                    start,
+                    goal,
+                    Err(Failure::NoStrategy),
+                    steps,
+                    repositions,
+                    traj,
+                ));
+            };
+            repositions += 1;
+            let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
+            let rel = at - o.position();
+            circle_walk(
+                io,
+                o.position(),
+                bound_all,
+                angle_of(rel),
+                p.heading_tolerance,
+            )?;
+            go_to(io, at, p.heading_tolerance)?;
+            o.vector_to_world(Vector2::new(rep.r[0], rep.r[1]))
+        } else {
+            let pl = o.point_to_local(r.position());
+            let Some(rr) = strategy.general([pl.x, pl.y], want) else {
+                return Ok(finish(
+                    io,
+                    start,
+                    goal,
+                    Err(Failure::NoStrategy),
+                    steps,
+                    repositions,
+                    traj,
+                ));
+            };
+            o.vector_to_world(Vector2::new(rr[0], rr[1]))
+        };
+        face(io, angle_of(dir_world), p.heading_tolerance)?;
+        let (r0, o0) = (io.robot_pose(), io.object_pose());
+        io.forward(step)?;
+        steps += 1;
+        let (r1, o1) = (io.robot_pose(), io.object_pose());
+        let sample = Sample::from_push(r0, r1, o0, o1);
+        let moved = o1.position() - o0.position();
+        if moved.norm() >= p.moved_epsilon {
+            strategy.add(sample);
+            sink(&sample)?;
+        }
+        // Special case next when the push moved the object away from the goal, or did not move
+        // it at all (the robot lost contact).
+        special = moved.norm() < p.moved_epsilon || moved.dot(&(goal - o0.position())) < 0.0;
+    }
+}
+
+/// Deliver the object to `goal` by following the dipole field (Igarashi et al.), the baseline.
+pub fn deliver_dipole(
+    io: &mut dyn RobotIo,
+    goal: Vector2<f64>,
+    p: &DeliveryParams,
+) -> Result<Delivery> {
+    let start = io.time();
+    let mut traj = Vec::new();
+    let mut steps = 0;
+    loop {
+        let (r, o) = (io.robot_pose(), io.object_pose());
+        traj.push((r, o));
+        if let Some(v) = verdict(io, &o, &r, goal, start, p) {
+            return Ok(finish(io, start, goal, v, steps, 0, traj));
+        }
+        steps += 1;
+        match dipole::command(o.position(), r.position(), r.theta, goal, &p.dipole) {
+            Some(DipoleCommand::Spin { angle }) => io.spin(angle)?,
+            Some(DipoleCommand::Drive { v, omega }) => io.drive(v, omega, p.dipole_step)?,
+            // Robot on top of the object's marker: back off a little.
+            None => io.forward(-0.02)?,
+        }
+    }
+}

@@ -1,0 +1,339 @@
+//! Object delivery by kernel regression over the pushing strategy: Lau, Mitani & Igarashi
+//! §III-E, Algorithm 2.
+//!
+//! General case: given the robot's position p and the wanted object motion s (the goal
+//! direction scaled by `offset`, both in the object's frame), take the k samples nearest in
+//! (p_x, p_y, s_x, s_y) and return the Gaussian-weighted mean of their robot motions r.
+//! Special case (the last push moved the object away from the goal): the k samples nearest in
+//! (s_x, s_y) alone give both where the robot should stand (p) and how it should push (r).
+//!
+//! Nearest neighbours come from `kiddo` k-d trees, so a query stays fast at 100 000 samples;
+//! samples added during delivery (the paper's supplemental samples, used at once) are searched
+//! linearly until enough of them gather to rebuild the trees.
+
+use std::num::NonZeroUsize;
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+
+use super::sample::Sample;
+
+/// Parameters of the regression.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KernelParams {
+    /// Neighbours used (the paper: 5).
+    pub k: usize,
+    /// Gaussian kernel width K_w, metres (the paper: 8 px ≈ 1.8 cm).
+    pub kernel_width: f64,
+}
+
+impl Default for KernelParams {
+    fn default() -> Self {
+        KernelParams {
+            k: 5,
+            kernel_width: 0.018,
+        }
+    }
+}
+
+/// The special case's answer: where to stand and how to push, object frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reposition {
+    /// Robot position to push from.
+    pub p: [f64; 2],
+    /// Robot motion of the push.
+    pub r: [f64; 2],
+}
+
+/// Samples added since the trees were built are searched linearly up to this many.
+const REBUILD_AFTER: usize = 256;
+
+/// A pushing strategy ready for queries.
+pub struct PushStrategy {
+    samples: Vec<Sample>,
+    params: KernelParams,
+    /// Over (p_x, p_y, s_x, s_y) of `samples[..indexed]`.
+    general: Option<ImmutableKdTree<f64, 4>>,
+    /// Over (s_x, s_y) of `samples[..indexed]`.
+    special: Option<ImmutableKdTree<f64, 2>>,
+    indexed: usize,
+    s_len_sum: f64,
+}
+
+fn general_key(s: &Sample) -> [f64; 4] {
+    [s.p[0], s.p[1], s.s[0], s.s[1]]
+}
+
+fn special_key(s: &Sample) -> [f64; 2] {
+    [s.s[0], s.s[1]]
+}
+
+fn dist2<const K: usize>(a: &[f64; K], b: &[f64; K]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+impl PushStrategy {
+    /// Index `samples` (non-finite samples are skipped).
+    pub fn new(samples: impl IntoIterator<Item = Sample>, params: KernelParams) -> Self {
+        let samples: Vec<Sample> = samples.into_iter().filter(Sample::is_finite).collect();
+        let mut s = PushStrategy {
+            s_len_sum: samples.iter().map(Sample::s_len).sum(),
+            samples,
+            params,
+            general: None,
+            special: None,
+            indexed: 0,
+        };
+        s.rebuild();
+        s
+    }
+
+    fn rebuild(&mut self) {
+        self.indexed = self.samples.len();
+        if self.samples.is_empty() {
+            self.general = None;
+            self.special = None;
+            return;
+        }
+        let g: Vec<[f64; 4]> = self.samples.iter().map(general_key).collect();
+        let s: Vec<[f64; 2]> = self.samples.iter().map(special_key).collect();
+        self.general = Some(ImmutableKdTree::new_from_slice(&g));
+        self.special = Some(ImmutableKdTree::new_from_slice(&s));
+    }
+
+    /// Add a sample for immediate use (non-finite samples are ignored).
+    pub fn add(&mut self, s: Sample) {
+        if !s.is_finite() {
+            return;
+        }
+        self.s_len_sum += s.s_len();
+        self.samples.push(s);
+        if self.samples.len() - self.indexed > REBUILD_AFTER {
+            self.rebuild();
+        }
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// Whether there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// The samples.
+    pub fn samples(&self) -> &[Sample] {
+        &self.samples
+    }
+
+    /// The paper's `offset`: the mean length of the samples' object displacements, so a query's
+    /// wanted motion has the length the data has.
+    pub fn offset(&self) -> f64 {
+        if self.samples.is_empty() {
+            0.0
+        } else {
+            self.s_len_sum / self.samples.len() as f64
+        }
+    }
+
+    /// The k nearest samples to `q` by `key`, as (squared distance, index), nearest first.
+    fn nearest<const K: usize>(
+        &self,
+        tree: Option<&ImmutableKdTree<f64, K>>,
+        key: fn(&Sample) -> [f64; K],
+        q: &[f64; K],
+    ) -> Vec<(f64, usize)> {
+        let k = self.params.k.max(1);
+        let mut found: Vec<(f64, usize)> = match (tree, NonZeroUsize::new(k)) {
+            (Some(t), Some(nz)) => t
+                .nearest_n::<SquaredEuclidean>(q, nz)
+                .into_iter()
+                .map(|n| (n.distance, n.item as usize))
+                .collect(),
+            _ => Vec::new(),
+        };
+        for (i, s) in self.samples.iter().enumerate().skip(self.indexed) {
+            found.push((dist2(&key(s), q), i));
+        }
+        found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        found.truncate(k);
+        found
+    }
+
+    /// Gaussian weights of neighbours; relative to the nearest so far-away queries do not
+    /// underflow to all-zero weights (the normalised mean is the same).
+    fn weights(&self, near: &[(f64, usize)]) -> Vec<f64> {
+        let kw2 = self.params.kernel_width * self.params.kernel_width;
+        let d0 = near.first().map_or(0.0, |n| n.0);
+        near.iter()
+            .map(|(d2, _)| (-(d2 - d0) / kw2).exp())
+            .collect()
+    }
+
+    /// General case: the robot motion r that moves the object along `goal_dir` (a unit vector)
+    /// from robot position `p`, both in the object's frame. `None` without samples or for a
+    /// non-finite query.
+    pub fn general(&self, p: [f64; 2], goal_dir: [f64; 2]) -> Option<[f64; 2]> {
+        let off = self.offset();
+        let q = [p[0], p[1], off * goal_dir[0], off * goal_dir[1]];
+        if q.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let near = self.nearest(self.general.as_ref(), general_key, &q);
+        let w = self.weights(&near);
+        let total: f64 = w.iter().sum();
+        if near.is_empty() || total <= 0.0 {
+            return None;
+        }
+        let mut r = [0.0; 2];
+        for ((_, i), wi) in near.iter().zip(&w) {
+            r[0] += wi * self.samples[*i].r[0];
+            r[1] += wi * self.samples[*i].r[1];
+        }
+        Some([r[0] / total, r[1] / total])
+    }
+
+    /// Special case: where to stand and how to push so the object moves along `goal_dir`.
+    pub fn special(&self, goal_dir: [f64; 2]) -> Option<Reposition> {
+        let off = self.offset();
+        let q = [off * goal_dir[0], off * goal_dir[1]];
+        if q.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let near = self.nearest(self.special.as_ref(), special_key, &q);
+        let w = self.weights(&near);
+        let total: f64 = w.iter().sum();
+        if near.is_empty() || total <= 0.0 {
+            return None;
+        }
+        let mut out = [0.0; 4];
+        for ((_, i), wi) in near.iter().zip(&w) {
+            let s = &self.samples[*i];
+            for (o, v) in out.iter_mut().zip([s.p[0], s.p[1], s.r[0], s.r[1]]) {
+                *o += wi * v;
+            }
+        }
+        Some(Reposition {
+            p: [out[0] / total, out[1] / total],
+            r: [out[2] / total, out[3] / total],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_samples(n: usize, seed: u64) -> Vec<Sample> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                let a: f64 = rng.random_range(-3.2..3.2);
+                let push: f64 = rng.random_range(0.01..0.05);
+                Sample {
+                    p: [0.08 * a.cos(), 0.08 * a.sin()],
+                    r: [
+                        -push * a.cos() + rng.random_range(-0.01..0.01),
+                        -push * a.sin(),
+                    ],
+                    s: [
+                        -0.8 * push * a.cos(),
+                        -0.8 * push * a.sin() + rng.random_range(-0.005..0.005),
+                    ],
+                    theta: rng.random_range(-0.2..0.2),
+                }
+            })
+            .collect()
+    }
+
+    /// Brute force: Algorithm 2 written out over every sample.
+    fn brute_general(
+        samples: &[Sample],
+        params: KernelParams,
+        p: [f64; 2],
+        dir: [f64; 2],
+    ) -> [f64; 2] {
+        let off = samples.iter().map(Sample::s_len).sum::<f64>() / samples.len() as f64;
+        let q = [p[0], p[1], off * dir[0], off * dir[1]];
+        let mut d: Vec<(f64, usize)> = samples
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (dist2(&general_key(s), &q), i))
+            .collect();
+        d.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let (mut r, mut tot) = ([0.0; 2], 0.0);
+        for (d2, i) in d.iter().take(params.k) {
+            let w = (-d2 / (params.kernel_width * params.kernel_width)).exp();
+            r[0] += w * samples[*i].r[0];
+            r[1] += w * samples[*i].r[1];
+            tot += w;
+        }
+        [r[0] / tot, r[1] / tot]
+    }
+
+    #[test]
+    fn general_case_matches_brute_force() {
+        let samples = random_samples(3000, 7);
+        let params = KernelParams::default();
+        // Part indexed, part recent: both search paths take part.
+        let mut strat = PushStrategy::new(samples[..2900].iter().copied(), params);
+        for s in &samples[2900..] {
+            strat.add(*s);
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        for _ in 0..300 {
+            let p = [rng.random_range(-0.1..0.1), rng.random_range(-0.1..0.1)];
+            let a: f64 = rng.random_range(-3.2..3.2);
+            let dir = [a.cos(), a.sin()];
+            let got = strat.general(p, dir).unwrap();
+            let want = brute_general(&samples, params, p, dir);
+            assert!(
+                (got[0] - want[0]).abs() < 1e-9 && (got[1] - want[1]).abs() < 1e-9,
+                "{got:?} vs {want:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn special_case_returns_the_push_that_moves_the_object_the_wanted_way() {
+        // Samples from a disc-like object: pushing from angle a moves it towards a + π.
+        let samples = random_samples(2000, 3);
+        let strat = PushStrategy::new(samples, KernelParams::default());
+        for a in [0.0f64, 1.0, 2.5, -2.0] {
+            let rep = strat.special([a.cos(), a.sin()]).unwrap();
+            // To move the object along a, stand on the opposite side and push along a.
+            let stand = rep.p[1].atan2(rep.p[0]);
+            let diff = crate::strategy::sample::wrap_angle(stand - (a + std::f64::consts::PI));
+            assert!(diff.abs() < 0.3, "a={a}: stands at {stand}");
+            let push = rep.r[1].atan2(rep.r[0]);
+            assert!(
+                crate::strategy::sample::wrap_angle(push - a).abs() < 0.4,
+                "a={a}: pushes {push}"
+            );
+        }
+    }
+
+    #[test]
+    fn far_queries_do_not_underflow_and_empty_strategies_answer_none() {
+        let strat = PushStrategy::new(random_samples(50, 1), KernelParams::default());
+        assert!(strat.general([100.0, 100.0], [1.0, 0.0]).is_some());
+        assert!(strat.general([f64::NAN, 0.0], [1.0, 0.0]).is_none());
+        let empty = PushStrategy::new(Vec::new(), KernelParams::default());
+        assert!(empty.general([0.0, 0.0], [1.0, 0.0]).is_none());
+        assert!(empty.special([1.0, 0.0]).is_none());
+    }
+
+    #[test]
+    fn many_identical_samples_are_fine() {
+        let s = random_samples(1, 5)[0];
+        let mut strat = PushStrategy::new(std::iter::repeat_n(s, 1000), KernelParams::default());
+        for _ in 0..600 {
+            strat.add(s);
+        }
+        let r = strat.general(s.p, [1.0, 0.0]).unwrap();
+        assert!((r[0] - s.r[0]).abs() < 1e-12 && (r[1] - s.r[1]).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,137 @@
+//! One push as a sample of the pushing strategy (Lau et al. §III-B, Fig. 2).
+//!
+//! A sample is (p_x, p_y, r_x, r_y, s_x, s_y, θ): the robot centre before the push (p), the
+//! robot's displacement (r), the object's displacement (s), all in the object's frame at the
+//! start of the push, and the object's change of heading θ.
+
+use nalgebra::{Rotation2, Vector2};
+
+/// A planar pose in table coordinates: metres and radians.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Pose2 {
+    /// x, m.
+    pub x: f64,
+    /// y, m.
+    pub y: f64,
+    /// Heading, rad.
+    pub theta: f64,
+}
+
+impl Pose2 {
+    /// A pose.
+    pub const fn new(x: f64, y: f64, theta: f64) -> Self {
+        Pose2 { x, y, theta }
+    }
+    /// Position as a vector.
+    pub fn position(&self) -> Vector2<f64> {
+        Vector2::new(self.x, self.y)
+    }
+    /// A table-frame vector expressed in this pose's frame (rotation only).
+    pub fn vector_to_local(&self, v: Vector2<f64>) -> Vector2<f64> {
+        Rotation2::new(-self.theta) * v
+    }
+    /// A vector of this pose's frame expressed in the table frame (rotation only).
+    pub fn vector_to_world(&self, v: Vector2<f64>) -> Vector2<f64> {
+        Rotation2::new(self.theta) * v
+    }
+    /// A table-frame point expressed in this pose's frame.
+    pub fn point_to_local(&self, p: Vector2<f64>) -> Vector2<f64> {
+        self.vector_to_local(p - self.position())
+    }
+    /// A point of this pose's frame expressed in the table frame.
+    pub fn point_to_world(&self, p: Vector2<f64>) -> Vector2<f64> {
+        self.vector_to_world(p) + self.position()
+    }
+}
+
+/// Wrap an angle to (−π, π].
+pub fn wrap_angle(a: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let r = a.rem_euclid(TAU);
+    if r > PI { r - TAU } else { r }
+}
+
+/// One push: the paper's (p_x, p_y, r_x, r_y, s_x, s_y, θ), metres and radians, object frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Robot centre before the push.
+    pub p: [f64; 2],
+    /// Robot displacement.
+    pub r: [f64; 2],
+    /// Object displacement.
+    pub s: [f64; 2],
+    /// Object rotation.
+    pub theta: f64,
+}
+
+impl Sample {
+    /// The sample for a push observed as robot and object poses before and after.
+    pub fn from_push(
+        robot_before: Pose2,
+        robot_after: Pose2,
+        obj_before: Pose2,
+        obj_after: Pose2,
+    ) -> Sample {
+        let p = obj_before.point_to_local(robot_before.position());
+        let r = obj_before.vector_to_local(robot_after.position() - robot_before.position());
+        let s = obj_before.vector_to_local(obj_after.position() - obj_before.position());
+        Sample {
+            p: [p.x, p.y],
+            r: [r.x, r.y],
+            s: [s.x, s.y],
+            theta: wrap_angle(obj_after.theta - obj_before.theta),
+        }
+    }
+
+    /// Whether every value is finite.
+    pub fn is_finite(&self) -> bool {
+        self.p
+            .iter()
+            .chain(&self.r)
+            .chain(&self.s)
+            .chain([&self.theta])
+            .all(|v| v.is_finite())
+    }
+
+    /// Length of the object's displacement.
+    pub fn s_len(&self) -> f64 {
+        self.s[0].hypot(self.s[1])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn push_is_expressed_in_the_object_frame() {
+        // Object at (1, 1) facing table +y: its local x is table +y, its local y is table −x.
+        // The robot at table (0.9, 1) is at local (0, 0.1); moving table +x is local −y.
+        let obj0 = Pose2::new(1.0, 1.0, FRAC_PI_2);
+        let obj1 = Pose2::new(1.05, 1.0, FRAC_PI_2 + 0.1);
+        let r0 = Pose2::new(0.9, 1.0, 0.0);
+        let r1 = Pose2::new(0.96, 1.0, 0.0);
+        let s = Sample::from_push(r0, r1, obj0, obj1);
+        assert!(
+            (s.p[0] - 0.0).abs() < 1e-12 && (s.p[1] - 0.1).abs() < 1e-12,
+            "{s:?}"
+        );
+        // Robot moved +x in the table = local −y.
+        assert!(
+            (s.r[0]).abs() < 1e-12 && (s.r[1] + 0.06).abs() < 1e-12,
+            "{s:?}"
+        );
+        assert!((s.s[1] + 0.05).abs() < 1e-12);
+        assert!((s.theta - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn wrap_angle_stays_in_half_open_interval() {
+        use std::f64::consts::PI;
+        assert!((wrap_angle(3.0 * PI) - PI).abs() < 1e-12);
+        assert!((wrap_angle(-PI) - PI).abs() < 1e-12);
+        assert!((wrap_angle(0.5) - 0.5).abs() < 1e-12);
+        assert!((wrap_angle(-0.5 - 2.0 * PI) + 0.5).abs() < 1e-12);
+    }
+}

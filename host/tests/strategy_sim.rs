@@ -1,0 +1,153 @@
+//! Lau, Mitani & Igarashi's collection (Algorithm 1) and delivery (Algorithm 2) on the simulated
+//! robot in process, and the dipole baseline beside it.
+
+use indicatif::ProgressBar;
+use nalgebra::Vector2;
+use pushbot::strategy::collect::{CollectParams, collect, reset_robot_obj_boundary};
+use pushbot::strategy::deliver::{DeliveryParams, deliver_learned};
+use pushbot::strategy::eval::{Method, TrialSetup, run_start};
+use pushbot::strategy::regression::{KernelParams, PushStrategy};
+use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
+use pushbot::strategy::sample::Sample;
+use pushbot::strategy::store::{StrategyWriter, load};
+use pushbot_sim::{Pose, Scene};
+
+fn initial_only(k: usize, seed: u64) -> CollectParams {
+    CollectParams {
+        initial: k,
+        streak: 0,
+        max_queries: 0,
+        seed,
+        ..CollectParams::default()
+    }
+}
+
+fn collect_samples(
+    scene: &str,
+    k: usize,
+    seed: u64,
+    mut w: Option<&mut StrategyWriter>,
+) -> Vec<Sample> {
+    let scene = Scene::preset(scene).unwrap();
+    let mut io = SimRobot::new(
+        scene,
+        None,
+        None,
+        SimRobotOptions {
+            seed,
+            ..SimRobotOptions::default()
+        },
+    )
+    .unwrap();
+    let mut strat = PushStrategy::new(Vec::new(), KernelParams::default());
+    let rep = collect(
+        &mut io,
+        &mut strat,
+        &initial_only(k, seed),
+        &mut |s| {
+            if let Some(w) = w.as_deref_mut() {
+                w.append(s)?;
+            }
+            Ok(())
+        },
+        &ProgressBar::hidden(),
+    )
+    .unwrap();
+    assert_eq!(rep.initial_samples, k, "{rep:?}");
+    assert_eq!(strat.len(), k);
+    strat.samples().to_vec()
+}
+
+#[test]
+fn collected_samples_reload_identically() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("irregular.strategy");
+    let (mut w, before) = StrategyWriter::open(&path, "irregular").unwrap();
+    assert!(before.is_empty());
+    let samples = collect_samples("lau-irregular", 25, 3, Some(&mut w));
+    drop(w);
+    let file = load(&path).unwrap();
+    assert_eq!(file.object, "irregular");
+    assert_eq!(file.samples, samples);
+    // Every sample is a push that moved the object, with the robot near it beforehand.
+    for s in &samples {
+        assert!(s.s_len() >= 0.003, "{s:?}");
+        assert!(s.p[0].hypot(s.p[1]) < 0.25, "{s:?}");
+    }
+}
+
+#[test]
+fn learned_delivery_succeeds_from_two_starts_and_dipole_runs_beside_it() {
+    let samples = collect_samples("lau-irregular", 160, 5, None);
+    let setup = TrialSetup {
+        scene: Scene::preset("lau-irregular").unwrap(),
+        object: None,
+        sim: SimRobotOptions {
+            seed: 11,
+            ..SimRobotOptions::default()
+        },
+        delivery: DeliveryParams {
+            time_limit: 240.0,
+            ..DeliveryParams::default()
+        },
+        kernel: KernelParams::default(),
+    };
+    let goal = setup.goal().unwrap();
+    for start in ["A", "C"] {
+        let (res, runs) = run_start(&setup, Method::Learned, &samples, start, 1).unwrap();
+        assert_eq!(res.successes, 1, "{start}: {res:?} {:?}", runs[0]);
+        assert!(runs[0].final_distance < 0.022);
+        // The object really travelled from its start to the goal.
+        let p = setup.scene.position(start).unwrap();
+        let straight = (goal - Vector2::new(p.x, p.y)).norm();
+        assert!(runs[0].object_path >= straight - 0.03, "{runs:?}");
+    }
+    // The baseline on the same set-up: it runs to a verdict, and it pushes.
+    let (res, runs) = run_start(&setup, Method::Dipole, &[], "A", 1).unwrap();
+    assert_eq!(res.trials, 1);
+    assert!(runs[0].success || runs[0].failure.is_some());
+    assert!(runs[0].robot_path > 0.1, "{:?}", runs[0]);
+}
+
+#[test]
+fn reset_robot_obj_boundary_brings_the_object_back() {
+    let mut scene = Scene::preset("lau-irregular").unwrap();
+    // Object 8 cm past the lower boundary (inset 0.2 m), robot above it.
+    scene.objects[0].pose = Pose::new(0.8, 0.12, 0.3);
+    scene.robot.start = Pose::new(0.8, 0.3, -1.5);
+    let mut io = SimRobot::new(scene, None, None, SimRobotOptions::default()).unwrap();
+    let ws = io.workspace();
+    assert!(!ws.boundary.contains(io.object_pose().position()));
+    let back = reset_robot_obj_boundary(&mut io, 0.02, 0.004).unwrap();
+    let o = io.true_object_pose();
+    assert!(back, "object at {o:?}");
+    assert!(ws.boundary.contains(o.position()), "{o:?}");
+}
+
+#[test]
+fn delivery_adds_supplemental_samples_at_once() {
+    let samples = collect_samples("lau-scissors", 60, 8, None);
+    let scene = Scene::preset("lau-scissors").unwrap();
+    let mut io = SimRobot::new(scene, None, Some("B"), SimRobotOptions::default()).unwrap();
+    let mut strat = PushStrategy::new(samples.iter().copied(), KernelParams::default());
+    let mut added = Vec::new();
+    let goal = Vector2::new(0.8, 0.6);
+    let d = deliver_learned(
+        &mut io,
+        &mut strat,
+        goal,
+        &DeliveryParams {
+            time_limit: 60.0,
+            ..DeliveryParams::default()
+        },
+        &mut |s| {
+            added.push(*s);
+            Ok(())
+        },
+    )
+    .unwrap();
+    assert!(d.steps > 0);
+    assert!(!added.is_empty());
+    assert_eq!(strat.len(), samples.len() + added.len());
+    assert_eq!(&strat.samples()[samples.len()..], &added[..]);
+}
