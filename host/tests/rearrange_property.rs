@@ -10,7 +10,8 @@ use std::collections::{BinaryHeap, HashMap, HashSet};
 
 use pushbot::planner::rearrange::problem::{Cell, rot};
 use pushbot::planner::rearrange::{
-    Config, ContactMode, Dir, Grid, Metric, Model, MovableSpec, Placement, Problem, RobotSpec, Rules, cost_map, restore,
+    Config, ContactMode, Dir, Grid, Metric, Model, MovableSpec, Placement, Problem, RobotSpec,
+    Rules, cost_map, restore,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,17 +33,28 @@ struct Naive<'a> {
 impl Naive<'_> {
     fn free(&self, c: Pos) -> bool {
         let g = &self.p.grid;
-        c.0 >= 0 && c.1 >= 0 && c.0 < g.w && c.1 < g.h && !g.cells[(c.1 * g.w + c.0) as usize].obstacle
+        c.0 >= 0
+            && c.1 >= 0
+            && c.0 < g.w
+            && c.1 < g.h
+            && !g.cells[(c.1 * g.w + c.0) as usize].obstacle
     }
     fn cell(&self, c: Pos) -> Cell {
         self.p.grid.cells[(c.1 * self.p.grid.w + c.0) as usize]
     }
     fn robot_cells(&self, a: Pos) -> HashSet<Pos> {
         let k = self.p.robot.size;
-        (0..k).flat_map(|y| (0..k).map(move |x| (a.0 + x, a.1 + y))).collect()
+        (0..k)
+            .flat_map(|y| (0..k).map(move |x| (a.0 + x, a.1 + y)))
+            .collect()
     }
     fn mov_cells(&self, i: usize, pl: Placement) -> HashSet<Pos> {
-        self.p.movables[i].cells.iter().map(|&c| rot(c, pl.o)).map(|(x, y)| (x + pl.x, y + pl.y)).collect()
+        self.p.movables[i]
+            .cells
+            .iter()
+            .map(|&c| rot(c, pl.o))
+            .map(|(x, y)| (x + pl.x, y + pl.y))
+            .collect()
     }
     fn valid(&self, s: &N) -> bool {
         let mut seen = HashSet::new();
@@ -57,14 +69,25 @@ impl Naive<'_> {
     }
     fn pass(&self, cells: &HashSet<Pos>) -> u32 {
         let f = self.p.metric.rough;
-        cells.iter().map(|&c| [1, f[0], f[1]][self.cell(c).rough.min(2) as usize]).max().unwrap_or(1)
+        cells
+            .iter()
+            .map(|&c| [1, f[0], f[1]][self.cell(c).rough.min(2) as usize])
+            .max()
+            .unwrap_or(1)
     }
     fn near(&self, cells: &HashSet<Pos>) -> bool {
-        cells.iter().any(|&(x, y)| (-1..=1).any(|dy| (-1..=1).any(|dx| !self.free((x + dx, y + dy)))))
+        cells
+            .iter()
+            .any(|&(x, y)| (-1..=1).any(|dy| (-1..=1).any(|dx| !self.free((x + dx, y + dy)))))
     }
     fn push_cost(&self, i: usize, cells: &HashSet<Pos>) -> u32 {
         let m = &self.p.metric;
-        self.p.movables[i].mass * self.pass(cells) + if m.safety > 0 && self.near(cells) { m.safety } else { 0 }
+        self.p.movables[i].mass * self.pass(cells)
+            + if m.safety > 0 && self.near(cells) {
+                m.safety
+            } else {
+                0
+            }
     }
     fn mem_cost(&self, prev: Option<(u8, bool)>, d: u8, kind: u8) -> u32 {
         // kind: 0 transit, 1 translate, 2 rotate
@@ -81,19 +104,24 @@ impl Naive<'_> {
     fn arrival_ok(&self, robot: Pos, m: &[Placement], pushed: &HashSet<usize>) -> bool {
         m.iter().enumerate().all(|(j, &pl)| {
             pushed.contains(&j)
-                || (self.mov_cells(j, pl).iter().all(|&c| !self.cell(c).no_leave)
-                    && self
-                        .p
-                        .rules
-                        .distance_limit
-                        .is_none_or(|l| ((robot.0 - pl.x).abs() + (robot.1 - pl.y).abs()) as u32 <= l))
+                || (self
+                    .mov_cells(j, pl)
+                    .iter()
+                    .all(|&c| !self.cell(c).no_leave)
+                    && self.p.rules.distance_limit.is_none_or(|l| {
+                        ((robot.0 - pl.x).abs() + (robot.1 - pl.y).abs()) as u32 <= l
+                    }))
         })
     }
     /// Leading edge of the robot moving d: its cells whose next cell in d is not the robot's.
     fn leading(&self, robot: Pos, d: Dir) -> HashSet<Pos> {
         let cells = self.robot_cells(robot);
         let (dx, dy) = d.delta();
-        cells.iter().copied().filter(|&(x, y)| !cells.contains(&(x + dx, y + dy))).collect()
+        cells
+            .iter()
+            .copied()
+            .filter(|&(x, y)| !cells.contains(&(x + dx, y + dy)))
+            .collect()
     }
     fn successors(&self, s: &N) -> Vec<(N, u32)> {
         let mut out = Vec::new();
@@ -105,12 +133,20 @@ impl Naive<'_> {
             if !rc.iter().all(|&c| self.free(c)) {
                 continue;
             }
-            let hit: HashSet<usize> =
-                (0..s.m.len()).filter(|&i| !self.mov_cells(i, s.m[i]).is_disjoint(&rc)).collect();
+            let hit: HashSet<usize> = (0..s.m.len())
+                .filter(|&i| !self.mov_cells(i, s.m[i]).is_disjoint(&rc))
+                .collect();
             if hit.is_empty() {
                 if self.arrival_ok(nr, &s.m, &HashSet::new()) {
                     let c = self.p.robot.mass * self.pass(&rc) + self.mem_cost(s.mem, d as u8, 0);
-                    out.push((N { robot: nr, mem: memory.then_some((d as u8, false)), m: s.m.clone() }, c));
+                    out.push((
+                        N {
+                            robot: nr,
+                            mem: memory.then_some((d as u8, false)),
+                            m: s.m.clone(),
+                        },
+                        c,
+                    ));
                 }
             } else if self.p.rules.push_dirs & (1 << d as u8) != 0 {
                 let lead = self.leading(s.robot, d);
@@ -133,14 +169,25 @@ impl Naive<'_> {
                 loop {
                     let moved: HashSet<Pos> = set
                         .iter()
-                        .flat_map(|&i| self.mov_cells(i, Placement { x: s.m[i].x + dx, y: s.m[i].y + dy, o: s.m[i].o }))
+                        .flat_map(|&i| {
+                            self.mov_cells(
+                                i,
+                                Placement {
+                                    x: s.m[i].x + dx,
+                                    y: s.m[i].y + dy,
+                                    o: s.m[i].o,
+                                },
+                            )
+                        })
                         .collect();
                     if !moved.iter().all(|&c| self.free(c)) {
                         blocked = true;
                         break;
                     }
                     let more: Vec<usize> = (0..s.m.len())
-                        .filter(|j| !set.contains(j) && !self.mov_cells(*j, s.m[*j]).is_disjoint(&moved))
+                        .filter(|j| {
+                            !set.contains(j) && !self.mov_cells(*j, s.m[*j]).is_disjoint(&moved)
+                        })
                         .collect();
                     if more.is_empty() {
                         break;
@@ -154,11 +201,22 @@ impl Naive<'_> {
                 let mut m2 = s.m.clone();
                 let mut c = self.p.robot.mass * self.pass(&rc) + self.mem_cost(s.mem, d as u8, 1);
                 for &i in &set {
-                    m2[i] = Placement { x: s.m[i].x + dx, y: s.m[i].y + dy, o: s.m[i].o };
+                    m2[i] = Placement {
+                        x: s.m[i].x + dx,
+                        y: s.m[i].y + dy,
+                        o: s.m[i].o,
+                    };
                     c += self.push_cost(i, &self.mov_cells(i, m2[i]));
                 }
                 if self.arrival_ok(nr, &m2, &set) {
-                    out.push((N { robot: nr, mem: memory.then_some((d as u8, true)), m: m2 }, c));
+                    out.push((
+                        N {
+                            robot: nr,
+                            mem: memory.then_some((d as u8, true)),
+                            m: m2,
+                        },
+                        c,
+                    ));
                 }
             }
         }
@@ -171,7 +229,15 @@ impl Naive<'_> {
             }
             let pl = s.m[i];
             for mode in &spec.modes {
-                let ContactMode::Rotate { point, dir, turn, shift } = *mode else { continue };
+                let ContactMode::Rotate {
+                    point,
+                    dir,
+                    turn,
+                    shift,
+                } = *mode
+                else {
+                    continue;
+                };
                 let d = dir.rotated(pl.o);
                 let (px, py) = rot(point, pl.o);
                 if !self.leading(s.robot, d).contains(&(pl.x + px, pl.y + py)) {
@@ -181,18 +247,27 @@ impl Naive<'_> {
                 let nr = (s.robot.0 + dx, s.robot.1 + dy);
                 let rc = self.robot_cells(nr);
                 let (sx, sy) = rot(shift, pl.o);
-                let np = Placement { x: pl.x + sx, y: pl.y + sy, o: ((pl.o as i8 + turn).rem_euclid(4)) as u8 };
+                let np = Placement {
+                    x: pl.x + sx,
+                    y: pl.y + sy,
+                    o: ((pl.o as i8 + turn).rem_euclid(4)) as u8,
+                };
                 let old = self.mov_cells(i, pl);
                 let new = self.mov_cells(i, np);
-                let others: HashSet<Pos> =
-                    (0..s.m.len()).filter(|&j| j != i).flat_map(|j| self.mov_cells(j, s.m[j])).collect();
+                let others: HashSet<Pos> = (0..s.m.len())
+                    .filter(|&j| j != i)
+                    .flat_map(|j| self.mov_cells(j, s.m[j]))
+                    .collect();
                 let xs = old.iter().chain(&new).map(|c| c.0);
                 let ys = old.iter().chain(&new).map(|c| c.1);
                 let (x0, x1) = (xs.clone().min().unwrap(), xs.max().unwrap());
                 let (y0, y1) = (ys.clone().min().unwrap(), ys.max().unwrap());
-                let sweep_ok = (y0..=y1).all(|y| (x0..=x1).all(|x| self.free((x, y)) && !others.contains(&(x, y))));
+                let sweep_ok = (y0..=y1)
+                    .all(|y| (x0..=x1).all(|x| self.free((x, y)) && !others.contains(&(x, y))));
                 if !sweep_ok
-                    || !rc.iter().all(|&c| self.free(c) && !others.contains(&c) && !new.contains(&c))
+                    || !rc
+                        .iter()
+                        .all(|&c| self.free(c) && !others.contains(&c) && !new.contains(&c))
                     || !new.iter().all(|&c| self.free(c) && !others.contains(&c))
                 {
                     continue;
@@ -202,21 +277,36 @@ impl Naive<'_> {
                 if !self.arrival_ok(nr, &m2, &HashSet::from([i])) {
                     continue;
                 }
-                let c = self.p.robot.mass * self.pass(&rc) + self.push_cost(i, &new) + self.mem_cost(s.mem, d as u8, 2);
-                out.push((N { robot: nr, mem: memory.then_some((d as u8, false)), m: m2 }, c));
+                let c = self.p.robot.mass * self.pass(&rc)
+                    + self.push_cost(i, &new)
+                    + self.mem_cost(s.mem, d as u8, 2);
+                out.push((
+                    N {
+                        robot: nr,
+                        mem: memory.then_some((d as u8, false)),
+                        m: m2,
+                    },
+                    c,
+                ));
             }
         }
         out
     }
     fn is_goal(&self, s: &N) -> bool {
         self.p.goal_robot.is_none_or(|g| g == s.robot)
-            && s.m.iter().zip(&self.p.goal_movables).all(|(pl, g)| g.is_none_or(|g| g == *pl))
+            && s.m
+                .iter()
+                .zip(&self.p.goal_movables)
+                .all(|(pl, g)| g.is_none_or(|g| g == *pl))
     }
     fn all_states(&self) -> Vec<N> {
         let g = &self.p.grid;
         let memory = self.p.metric.turn > 0 || self.p.metric.mode_change > 0;
-        let mems: Vec<Option<(u8, bool)>> =
-            if memory { (0..8).map(|a| Some((a / 2, a % 2 == 1))).collect() } else { vec![None] };
+        let mems: Vec<Option<(u8, bool)>> = if memory {
+            (0..8).map(|a| Some((a / 2, a % 2 == 1))).collect()
+        } else {
+            vec![None]
+        };
         let mut bodies: Vec<Vec<Placement>> = Vec::new();
         for spec in &self.p.movables {
             let mut v = Vec::new();
@@ -232,13 +322,20 @@ impl Naive<'_> {
         let mut out = Vec::new();
         let mut combos: Vec<Vec<Placement>> = vec![vec![]];
         for b in &bodies {
-            combos = combos.iter().flat_map(|c| b.iter().map(move |&p| [c.clone(), vec![p]].concat())).collect();
+            combos = combos
+                .iter()
+                .flat_map(|c| b.iter().map(move |&p| [c.clone(), vec![p]].concat()))
+                .collect();
         }
         for m in combos {
             for y in 0..g.h {
                 for x in 0..g.w {
                     for &mem in &mems {
-                        let s = N { robot: (x, y), mem, m: m.clone() };
+                        let s = N {
+                            robot: (x, y),
+                            mem,
+                            m: m.clone(),
+                        };
                         if self.valid(&s) {
                             out.push(s);
                         }
@@ -251,8 +348,16 @@ impl Naive<'_> {
 }
 
 fn to_config(s: &N) -> Config {
-    let (heading, pushing) = s.mem.map(|(d, p)| (Dir::from_index(d as usize), p)).unwrap_or((Dir::E, false));
-    Config { robot: s.robot, heading, pushing, movables: s.m.clone() }
+    let (heading, pushing) = s
+        .mem
+        .map(|(d, p)| (Dir::from_index(d as usize), p))
+        .unwrap_or((Dir::E, false));
+    Config {
+        robot: s.robot,
+        heading,
+        pushing,
+        movables: s.m.clone(),
+    }
 }
 
 fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
@@ -265,13 +370,21 @@ fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
         }
         c.no_leave = rng.random_bool(0.08);
     }
-    let robot = RobotSpec { size: if rng.random_bool(0.2) { 2 } else { 1 }, mass: rng.random_range(1..=2) };
+    let robot = RobotSpec {
+        size: if rng.random_bool(0.2) { 2 } else { 1 },
+        mass: rng.random_range(1..=2),
+    };
     let nm = rng.random_range(1..=2);
-    let shapes: [Vec<(i32, i32)>; 3] = [vec![(0, 0)], vec![(0, 0), (1, 0)], vec![(0, 0), (1, 0), (0, 1)]];
+    let shapes: [Vec<(i32, i32)>; 3] = [
+        vec![(0, 0)],
+        vec![(0, 0), (1, 0)],
+        vec![(0, 0), (1, 0), (0, 1)],
+    ];
     let mut movables = Vec::new();
     for i in 0..nm {
         let cells = shapes[[0, 0, 0, 1, 1, 2][rng.random_range(0..6)]].clone();
-        let mut spec = MovableSpec::with_faces(&format!("m{i}"), cells.clone(), rng.random_range(0..=3));
+        let mut spec =
+            MovableSpec::with_faces(&format!("m{i}"), cells.clone(), rng.random_range(0..=3));
         if rng.random_bool(0.4) {
             spec.modes.retain(|_| rng.random_bool(0.5));
         }
@@ -280,7 +393,9 @@ fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
             // random rotational modes: a contact point next to the shape, a turn and a shift
             let faces: Vec<ContactMode> = pushbot::planner::rearrange::problem::face_modes(&cells);
             for _ in 0..rng.random_range(1..=3) {
-                if let ContactMode::Translate { point, dir } = faces[rng.random_range(0..faces.len())] {
+                if let ContactMode::Translate { point, dir } =
+                    faces[rng.random_range(0..faces.len())]
+                {
                     spec.modes.push(ContactMode::Rotate {
                         point,
                         dir,
@@ -293,9 +408,17 @@ fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
         movables.push(spec);
     }
     let rules = Rules {
-        push_dirs: if rng.random_bool(0.7) { 0b1111 } else { rng.random_range(1..16) },
+        push_dirs: if rng.random_bool(0.7) {
+            0b1111
+        } else {
+            rng.random_range(1..16)
+        },
         max_pushed: rng.random_range(0..=2),
-        distance_limit: if rng.random_bool(0.3) { Some(rng.random_range(2..=5)) } else { None },
+        distance_limit: if rng.random_bool(0.3) {
+            Some(rng.random_range(2..=5))
+        } else {
+            None
+        },
         strict_contact: rng.random_bool(0.7),
         rotations: rng.random_bool(0.8),
     };
@@ -307,7 +430,10 @@ fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
         mode_change: if memory { rng.random_range(1..=3) } else { 0 },
     };
     // size guard for the naive enumeration
-    let orients: i64 = movables.iter().map(|m| if m.rotates { 4 } else { 1 }).product();
+    let orients: i64 = movables
+        .iter()
+        .map(|m| if m.rotates { 4 } else { 1 })
+        .product();
     let n = (w * h) as i64;
     let total = n.pow(1 + nm as u32) * orients * if memory { 8 } else { 1 };
     if total > 120_000 {
@@ -320,7 +446,12 @@ fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
         movables,
         rules,
         metric,
-        start: Config { robot: (0, 0), heading: Dir::E, pushing: false, movables: vec![] },
+        start: Config {
+            robot: (0, 0),
+            heading: Dir::E,
+            pushing: false,
+            movables: vec![],
+        },
         goal_robot: None,
         goal_movables: vec![],
     };
@@ -333,7 +464,16 @@ fn random_problem(rng: &mut ChaCha8Rng) -> Option<Problem> {
     let s = states[rng.random_range(0..states.len())].clone();
     let g = states[rng.random_range(0..states.len())].clone();
     p.start = to_config(&N { mem: None, ..s });
-    p.goal_movables = g.m.iter().map(|&pl| if rng.random_bool(0.85) { Some(pl) } else { None }).collect();
+    p.goal_movables =
+        g.m.iter()
+            .map(|&pl| {
+                if rng.random_bool(0.85) {
+                    Some(pl)
+                } else {
+                    None
+                }
+            })
+            .collect();
     if rng.random_bool(0.15) {
         p.goal_robot = Some(g.robot);
     }
@@ -350,15 +490,28 @@ fn cost_map_equals_naive_optimum_and_restored_plans_are_legal() {
     let mut with_finite_start = 0;
     let mut plans_with_pushes = 0;
     while checked < 60 {
-        let Some(p) = random_problem(&mut rng) else { continue };
+        let Some(p) = random_problem(&mut rng) else {
+            continue;
+        };
         let model = Model::new(&p).expect("random problems are well formed");
         let map = cost_map(&model).expect("small maps do not overflow");
         let naive = Naive { p: &p };
         let states = naive.all_states();
-        let index: HashMap<N, usize> = states.iter().cloned().enumerate().map(|(i, s)| (s, i)).collect();
+        let index: HashMap<N, usize> = states
+            .iter()
+            .cloned()
+            .enumerate()
+            .map(|(i, s)| (s, i))
+            .collect();
         let succ: Vec<Vec<(usize, u32)>> = states
             .iter()
-            .map(|s| naive.successors(s).into_iter().map(|(t, c)| (index[&t], c)).collect())
+            .map(|s| {
+                naive
+                    .successors(s)
+                    .into_iter()
+                    .map(|(t, c)| (index[&t], c))
+                    .collect()
+            })
             .collect();
         // optimum to the goal set over the naive graph (Dijkstra on reversed naive edges)
         let mut pred: Vec<Vec<(usize, u32)>> = vec![Vec::new(); states.len()];
@@ -388,12 +541,17 @@ fn cost_map_equals_naive_optimum_and_restored_plans_are_legal() {
         }
         let mut finite = 0u64;
         for (i, s) in states.iter().enumerate() {
-            let idx = model.pack(&to_config(s)).unwrap_or_else(|| panic!("naive state {s:?} not packable"));
+            let idx = model
+                .pack(&to_config(s))
+                .unwrap_or_else(|| panic!("naive state {s:?} not packable"));
             let want = (dist[i] != u32::MAX).then_some(dist[i]);
             assert_eq!(map.get(idx), want, "cost of {s:?} in problem {p:#?}");
             finite += want.is_some() as u64;
         }
-        assert_eq!(map.stats.states_mapped, finite, "map has finite costs outside the naive free space");
+        assert_eq!(
+            map.stats.states_mapped, finite,
+            "map has finite costs outside the naive free space"
+        );
         // forward Dijkstra and restoration from sampled starts
         for _ in 0..6 {
             let s0 = rng.random_range(0..states.len());
@@ -426,12 +584,20 @@ fn cost_map_equals_naive_optimum_and_restored_plans_are_legal() {
                     for st in &plan.steps {
                         let next = index.get(&N {
                             robot: st.config.robot,
-                            mem: states[cur].mem.map(|_| (st.config.heading as u8, st.config.pushing)),
+                            mem: states[cur]
+                                .mem
+                                .map(|_| (st.config.heading as u8, st.config.pushing)),
                             m: st.config.movables.clone(),
                         });
                         let next = *next.expect("restored configuration is free");
-                        let legal = succ[cur].iter().any(|&(v, c)| v == next && c == st.step.cost);
-                        assert!(legal, "restored step {:?} is not a naive move of that cost", st.step);
+                        let legal = succ[cur]
+                            .iter()
+                            .any(|&(v, c)| v == next && c == st.step.cost);
+                        assert!(
+                            legal,
+                            "restored step {:?} is not a naive move of that cost",
+                            st.step
+                        );
                         total += st.step.cost;
                         cur = next;
                     }
@@ -444,6 +610,12 @@ fn cost_map_equals_naive_optimum_and_restored_plans_are_legal() {
         }
         checked += 1;
     }
-    assert!(with_finite_start > 20, "too few solvable starts sampled: {with_finite_start}");
-    assert!(plans_with_pushes > 10, "too few plans with pushes: {plans_with_pushes}");
+    assert!(
+        with_finite_start > 20,
+        "too few solvable starts sampled: {with_finite_start}"
+    );
+    assert!(
+        plans_with_pushes > 10,
+        "too few plans with pushes: {plans_with_pushes}"
+    );
 }

@@ -8,8 +8,8 @@ use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
 use crate::planner::rearrange::{
-    self, Config, Dir, Grid, Metric, Model, MoveKind, MovableSpec, Placement, Problem, RestoreError, RobotSpec,
-    Rules, cases,
+    self, Config, Dir, Grid, Metric, Model, MovableSpec, MoveKind, Placement, Problem,
+    RestoreError, RobotSpec, Rules, cases,
 };
 
 /// Arguments of `pushbot plan rearrange`.
@@ -43,7 +43,10 @@ pub fn peak_kib() -> Option<u64> {
 
 fn step_json(model: &Model, st: &rearrange::restore::PlanStep) -> serde_json::Value {
     let names = |mask: u8| -> Vec<String> {
-        (0..model.r()).filter(|i| mask & (1 << i) != 0).map(|i| model.problem.movables[i].name.clone()).collect()
+        (0..model.r())
+            .filter(|i| mask & (1 << i) != 0)
+            .map(|i| model.problem.movables[i].name.clone())
+            .collect()
     };
     let (kind, pushed, turn) = match st.step.kind {
         MoveKind::Transit => ("transit", vec![], 0),
@@ -65,19 +68,21 @@ fn step_json(model: &Model, st: &rearrange::restore::PlanStep) -> serde_json::Va
 /// Run `pushbot plan rearrange`.
 pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
     let problem = cases::load_scene(&args.scene).map_err(CliError::bad_input)?;
-    let model = Model::new(&problem).map_err(|e| CliError::bad_input(format!("scene `{}`: {e}", args.scene)))?;
+    let model = Model::new(&problem)
+        .map_err(|e| CliError::bad_input(format!("scene `{}`: {e}", args.scene)))?;
     let map = rearrange::cost_map(&model).map_err(|e| CliError::Failed(e.into()))?;
-    let start = model
-        .pack(&problem.start)
-        .ok_or_else(|| CliError::bad_input(format!("scene `{}`: the start is not free", args.scene)))?;
+    let start = model.pack(&problem.start).ok_or_else(|| {
+        CliError::bad_input(format!("scene `{}`: the start is not free", args.scene))
+    })?;
     let result = rearrange::restore(&model, &map, start);
     let peak = peak_kib();
     let st = &map.stats;
     match &result {
         Ok(p) => {
             if let Some(path) = &args.svg {
-                std::fs::write(path, rearrange::svg::plan_svg(&model, p))
-                    .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display())))?;
+                std::fs::write(path, rearrange::svg::plan_svg(&model, p)).map_err(|e| {
+                    CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display()))
+                })?;
             }
             if global.json {
                 let j = json!({
@@ -147,7 +152,10 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
                 });
                 println!("{j}");
             } else {
-                println!("{}: {e} (mapped {} configurations in {:.1} ms)", problem.name, st.states_mapped, st.map_ms);
+                println!(
+                    "{}: {e} (mapped {} configurations in {:.1} ms)",
+                    problem.name, st.states_mapped, st.map_ms
+                );
             }
             match e {
                 RestoreError::Inconsistent(_) => Err(CliError::Failed(anyhow::anyhow!("{e}"))),
@@ -160,10 +168,25 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
 /// A benchmark room: `side × side`, no inner obstacles, the robot and `boxes` one-cell boxes of
 /// mass 1, one box at a time; goals in a row along the bottom, the robot anywhere.
 pub fn bench_problem(side: i32, boxes: usize) -> Problem {
-    let movables: Vec<MovableSpec> =
-        (0..boxes).map(|i| MovableSpec::with_faces(&format!("b{i}"), vec![(0, 0)], 1)).collect();
-    let starts = (0..boxes).map(|i| Placement { x: 2 + 2 * i as i32, y: 2, o: 0 }).collect();
-    let goals = (0..boxes).map(|i| Some(Placement { x: side - 3 - 2 * i as i32, y: side - 3, o: 0 })).collect();
+    let movables: Vec<MovableSpec> = (0..boxes)
+        .map(|i| MovableSpec::with_faces(&format!("b{i}"), vec![(0, 0)], 1))
+        .collect();
+    let starts = (0..boxes)
+        .map(|i| Placement {
+            x: 2 + 2 * i as i32,
+            y: 2,
+            o: 0,
+        })
+        .collect();
+    let goals = (0..boxes)
+        .map(|i| {
+            Some(Placement {
+                x: side - 3 - 2 * i as i32,
+                y: side - 3,
+                o: 0,
+            })
+        })
+        .collect();
     Problem {
         name: format!("{boxes}box-{side}x{side}"),
         grid: Grid::new(side, side),
@@ -171,7 +194,12 @@ pub fn bench_problem(side: i32, boxes: usize) -> Problem {
         movables,
         rules: Rules::default(),
         metric: Metric::default(),
-        start: Config { robot: (0, 0), heading: Dir::E, pushing: false, movables: starts },
+        start: Config {
+            robot: (0, 0),
+            heading: Dir::E,
+            pushing: false,
+            movables: starts,
+        },
         goal_robot: None,
         goal_movables: goals,
     }
@@ -179,11 +207,16 @@ pub fn bench_problem(side: i32, boxes: usize) -> Problem {
 
 /// Run `pushbot bench rearrange`.
 pub fn bench(global: &Global, args: BenchArgs) -> CliResult {
-    let mut runs = vec![("2box", if args.quick { 10 } else { 20 }, 2), ("3box", if args.quick { 8 } else { 12 }, 3)];
+    let mut runs = vec![
+        ("2box", if args.quick { 10 } else { 20 }, 2),
+        ("3box", if args.quick { 8 } else { 12 }, 3),
+    ];
     if let Some(only) = &args.only {
         runs.retain(|r| r.0 == only);
         if runs.is_empty() {
-            return Err(CliError::bad_input(format!("--only {only}: use 2box or 3box")));
+            return Err(CliError::bad_input(format!(
+                "--only {only}: use 2box or 3box"
+            )));
         }
     }
     let mut results = Vec::new();
@@ -193,7 +226,9 @@ pub fn bench(global: &Global, args: BenchArgs) -> CliResult {
         let model = Model::new(&problem).map_err(|e| CliError::Failed(e.into()))?;
         let build_ms = t0.elapsed().as_secs_f64() * 1e3;
         let map = rearrange::cost_map(&model).map_err(|e| CliError::Failed(e.into()))?;
-        let start = model.pack(&problem.start).ok_or_else(|| CliError::Failed(anyhow::anyhow!("bench start")))?;
+        let start = model
+            .pack(&problem.start)
+            .ok_or_else(|| CliError::Failed(anyhow::anyhow!("bench start")))?;
         let plan = rearrange::restore(&model, &map, start);
         let st = map.stats;
         let (cost, restore_ms) = match &plan {

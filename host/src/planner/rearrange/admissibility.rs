@@ -57,7 +57,11 @@ pub struct Step {
 impl Model {
     #[inline]
     fn prev_memory(&self, aux: u32) -> Option<(Dir, bool)> {
-        if self.n_aux == 1 { None } else { Some((Dir::from_index((aux / 2) as usize), aux % 2 == 1)) }
+        if self.n_aux == 1 {
+            None
+        } else {
+            Some((Dir::from_index((aux / 2) as usize), aux % 2 == 1))
+        }
     }
 
     /// After a move: movables not pushed (bit mask) may be left where they are and are close
@@ -102,8 +106,13 @@ impl Model {
             if !self.arrival_ok(r2, &s.m, 0) {
                 return None;
             }
-            let cost = self.robot_cost[r2 as usize] + metric.memory_cost(prev, d, StepKind::Transit);
-            let t = State { aux: self.aux_of(d, false), r: r2, m: s.m };
+            let cost =
+                self.robot_cost[r2 as usize] + metric.memory_cost(prev, d, StepKind::Transit);
+            let t = State {
+                aux: self.aux_of(d, false),
+                r: r2,
+                m: s.m,
+            };
             return Some((t, cost, MoveKind::Transit));
         }
         let rules = &self.problem.rules;
@@ -150,13 +159,18 @@ impl Model {
         if !self.arrival_ok(r2, &m2, mask) {
             return None;
         }
-        let mut cost = self.robot_cost[r2 as usize] + metric.memory_cost(prev, d, StepKind::Translate);
+        let mut cost =
+            self.robot_cost[r2 as usize] + metric.memory_cost(prev, d, StepKind::Translate);
         for (i, &mi) in m2.iter().enumerate().take(n) {
             if mask & (1 << i) != 0 {
                 cost += self.push_cost[i][mi as usize];
             }
         }
-        let t = State { aux: self.aux_of(d, true), r: r2, m: m2 };
+        let t = State {
+            aux: self.aux_of(d, true),
+            r: r2,
+            m: m2,
+        };
         Some((t, cost, MoveKind::Push { pushed: mask as u8 }))
     }
 
@@ -171,7 +185,11 @@ impl Model {
         if r2 == NONE {
             return None;
         }
-        let post = super::problem::Placement { x: mp.x + inst.shift.0, y: mp.y + inst.shift.1, o: inst.post_o };
+        let post = super::problem::Placement {
+            x: mp.x + inst.shift.0,
+            y: mp.y + inst.shift.1,
+            o: inst.post_o,
+        };
         let m2i = self.movables[i].lookup(self.w(), self.h(), post);
         if m2i == NONE || self.rm_overlap(i, r2, m2i) {
             return None;
@@ -202,8 +220,18 @@ impl Model {
         let prev = self.prev_memory(s.aux);
         let cost = self.robot_cost[r2 as usize]
             + self.push_cost[i][m2i as usize]
-            + self.problem.metric.memory_cost(prev, inst.dir, StepKind::Rotate);
-        Some((State { aux: self.aux_of(inst.dir, false), r: r2, m: m2 }, cost))
+            + self
+                .problem
+                .metric
+                .memory_cost(prev, inst.dir, StepKind::Rotate);
+        Some((
+            State {
+                aux: self.aux_of(inst.dir, false),
+                r: r2,
+                m: m2,
+            },
+            cost,
+        ))
     }
 
     /// The admissible neighbours N_A(Q) of a packed configuration, with their costs.
@@ -215,15 +243,32 @@ impl Model {
         }
         for d in Dir::ALL {
             if let Some((t, cost, kind)) = self.try_step(&s, d) {
-                out.push(Step { to: self.encode(&t), cost, dir: d, kind });
+                out.push(Step {
+                    to: self.encode(&t),
+                    cost,
+                    dir: d,
+                    kind,
+                });
             }
         }
         for i in 0..self.r() {
             let o = self.movables[i].place[s.m[i] as usize].o;
             for inst in &self.rot_pre[i][o as usize] {
                 if let Some((t, cost)) = self.try_rotate(&s, i, inst) {
-                    let turn = if (inst.post_o + 4 - inst.pre_o) % 4 == 1 { 1 } else { -1 };
-                    out.push(Step { to: self.encode(&t), cost, dir: inst.dir, kind: MoveKind::Rotate { movable: i as u8, turn } });
+                    let turn = if (inst.post_o + 4 - inst.pre_o) % 4 == 1 {
+                        1
+                    } else {
+                        -1
+                    };
+                    out.push(Step {
+                        to: self.encode(&t),
+                        cost,
+                        dir: inst.dir,
+                        kind: MoveKind::Rotate {
+                            movable: i as u8,
+                            turn,
+                        },
+                    });
                 }
             }
         }
@@ -244,19 +289,24 @@ impl Model {
             (&Dir::ALL[d..d + 1], q.aux % 2 == 0, q.aux % 2 == 1)
         };
         let transit_arrival = transit_ok && self.arrival_ok(q.r, &q.m, 0);
+        // Origins differ from Q in a few digits: build their indices by strides, not by encoding.
+        let base = idx - q.aux;
+        let sr = self.stride[1];
         for &d in dirs {
             let rh = self.robot.shift[q.r as usize * 4 + d.opposite() as usize];
             if rh == NONE {
                 continue;
             }
             if transit_arrival && (0..n).all(|i| !self.rm_overlap(i, rh, q.m[i])) {
-                let base = self.robot_cost[q.r as usize];
-                let mut p = q;
-                p.r = rh;
-                for a in 0..self.n_aux {
-                    p.aux = a;
-                    let c = base + metric.memory_cost(self.prev_memory(a), d, StepKind::Transit);
-                    out.push((self.encode(&p), c));
+                let c0 = self.robot_cost[q.r as usize];
+                let b = base.wrapping_add(rh.wrapping_sub(q.r).wrapping_mul(sr));
+                if self.n_aux == 1 {
+                    out.push((b, c0));
+                } else {
+                    for a in 0..self.n_aux {
+                        let c = c0 + metric.memory_cost(self.prev_memory(a), d, StepKind::Transit);
+                        out.push((b + a, c));
+                    }
                 }
             }
             if !push_ok || self.problem.rules.push_dirs & (1 << d as u8) == 0 {
@@ -307,12 +357,20 @@ impl Model {
                 if !dirs.contains(&inst.dir) {
                     continue;
                 }
-                let pre = super::problem::Placement { x: mp.x - inst.shift.0, y: mp.y - inst.shift.1, o: inst.pre_o };
+                let pre = super::problem::Placement {
+                    x: mp.x - inst.shift.0,
+                    y: mp.y - inst.shift.1,
+                    o: inst.pre_o,
+                };
                 let mhi = self.movables[i].lookup(self.w(), self.h(), pre);
                 if mhi == NONE {
                     continue;
                 }
-                let rpre = super::problem::Placement { x: pre.x + inst.robot_off.0, y: pre.y + inst.robot_off.1, o: 0 };
+                let rpre = super::problem::Placement {
+                    x: pre.x + inst.robot_off.0,
+                    y: pre.y + inst.robot_off.1,
+                    o: 0,
+                };
                 let rh = self.robot.lookup(self.w(), self.h(), rpre);
                 if rh == NONE || self.robot.shift[rh as usize * 4 + inst.dir as usize] != q.r {
                     continue;

@@ -47,7 +47,8 @@ use toml::Spanned;
 
 use super::metric::Metric;
 use super::problem::{
-    Cell, Config, ContactMode, Dir, Grid, MovableSpec, Placement, Problem, RobotSpec, Rules, face_modes,
+    Cell, Config, ContactMode, Dir, Grid, MovableSpec, Placement, Problem, RobotSpec, Rules,
+    face_modes,
 };
 
 /// Why a scene could not be read.
@@ -136,7 +137,13 @@ struct RulesFile {
 
 impl Default for RulesFile {
     fn default() -> Self {
-        RulesFile { max_pushed: 1, push_dirs: None, distance_limit: None, strict_contact: true, rotations: true }
+        RulesFile {
+            max_pushed: 1,
+            push_dirs: None,
+            distance_limit: None,
+            strict_contact: true,
+            rotations: true,
+        }
     }
 }
 
@@ -167,24 +174,41 @@ fn yes() -> bool {
 
 /// 1-based line of a byte offset.
 fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+    text[..offset.min(text.len())]
+        .bytes()
+        .filter(|&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// Parse a scene from TOML text. Errors name the line and the field.
 pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError> {
     let f: SceneFile = toml::from_str(text).map_err(|e| SceneError(format!("scene: {e}")))?;
     let err = |span: std::ops::Range<usize>, field: &str, msg: String| -> SceneError {
-        SceneError(format!("scene line {}: `{field}`: {msg}", line_of(text, span.start)))
+        SceneError(format!(
+            "scene line {}: `{field}`: {msg}",
+            line_of(text, span.start)
+        ))
     };
     // map
     let map_span = f.map.span();
-    let rows: Vec<&str> = f.map.get_ref().lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    let rows: Vec<&str> = f
+        .map
+        .get_ref()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
     if rows.is_empty() {
         return Err(err(map_span, "map", "the map has no rows".into()));
     }
     let w = rows[0].chars().count();
     if w > 256 || rows.len() > 256 {
-        return Err(err(map_span, "map", "the map may be at most 256 × 256".into()));
+        return Err(err(
+            map_span,
+            "map",
+            "the map may be at most 256 × 256".into(),
+        ));
     }
     let mut grid = Grid::new(w as i32, rows.len() as i32);
     for (y, row) in rows.iter().enumerate() {
@@ -192,21 +216,41 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError
             return Err(err(
                 map_span.clone(),
                 "map",
-                format!("row {} has {} cells, the first row {w}", y + 1, row.chars().count()),
+                format!(
+                    "row {} has {} cells, the first row {w}",
+                    y + 1,
+                    row.chars().count()
+                ),
             ));
         }
         for (x, ch) in row.chars().enumerate() {
             let cell = match ch {
                 '.' => Cell::default(),
-                '#' => Cell { obstacle: true, ..Cell::default() },
-                ',' => Cell { rough: 1, ..Cell::default() },
-                ';' => Cell { rough: 2, ..Cell::default() },
-                'x' => Cell { no_leave: true, ..Cell::default() },
+                '#' => Cell {
+                    obstacle: true,
+                    ..Cell::default()
+                },
+                ',' => Cell {
+                    rough: 1,
+                    ..Cell::default()
+                },
+                ';' => Cell {
+                    rough: 2,
+                    ..Cell::default()
+                },
+                'x' => Cell {
+                    no_leave: true,
+                    ..Cell::default()
+                },
                 other => {
                     return Err(err(
                         map_span.clone(),
                         "map",
-                        format!("row {} column {}: unknown cell '{other}' (use . # , ; x)", y + 1, x + 1),
+                        format!(
+                            "row {} column {}: unknown cell '{other}' (use . # , ; x)",
+                            y + 1,
+                            x + 1
+                        ),
                     ));
                 }
             };
@@ -214,16 +258,29 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError
         }
     }
     let parse_dir = |s: &Spanned<String>, field: &str| -> Result<Dir, SceneError> {
-        Dir::parse(s.get_ref()).ok_or_else(|| err(s.span(), field, format!("'{}' is not one of N, E, S, W", s.get_ref())))
+        Dir::parse(s.get_ref()).ok_or_else(|| {
+            err(
+                s.span(),
+                field,
+                format!("'{}' is not one of N, E, S, W", s.get_ref()),
+            )
+        })
     };
     let in_grid = |p: &Spanned<[i32; 2]>, field: &str| -> Result<(i32, i32), SceneError> {
         let [x, y] = *p.get_ref();
         if grid.get(x, y).is_none() {
-            return Err(err(p.span(), field, format!("[{x}, {y}] is outside the {}×{} map", grid.w, grid.h)));
+            return Err(err(
+                p.span(),
+                field,
+                format!("[{x}, {y}] is outside the {}×{} map", grid.w, grid.h),
+            ));
         }
         Ok((x, y))
     };
-    let robot = RobotSpec { size: f.robot.size, mass: f.robot.mass };
+    let robot = RobotSpec {
+        size: f.robot.size,
+        mass: f.robot.mass,
+    };
     let start_robot = in_grid(&f.robot.at, "robot.at")?;
     let heading = match &f.robot.heading {
         Some(h) => parse_dir(h, "robot.heading")?,
@@ -239,25 +296,48 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError
     for m in &f.movables {
         let name = m.name.get_ref().clone();
         let field = |s: &str| format!("movable `{name}`.{s}");
-        let cells: Vec<(i32, i32)> = m.cells.clone().unwrap_or_else(|| vec![[0, 0]]).iter().map(|c| (c[0], c[1])).collect();
+        let cells: Vec<(i32, i32)> = m
+            .cells
+            .clone()
+            .unwrap_or_else(|| vec![[0, 0]])
+            .iter()
+            .map(|c| (c[0], c[1]))
+            .collect();
         if cells.is_empty() {
-            return Err(err(m.name.span(), &field("cells"), "needs at least one cell".into()));
+            return Err(err(
+                m.name.span(),
+                &field("cells"),
+                "needs at least one cell".into(),
+            ));
         }
         if m.orientation > 3 || m.goal_orientation.is_some_and(|o| o > 3) {
-            return Err(err(m.name.span(), &field("orientation"), "must be 0..=3".into()));
+            return Err(err(
+                m.name.span(),
+                &field("orientation"),
+                "must be 0..=3".into(),
+            ));
         }
         let mut modes = Vec::new();
         if m.faces.unwrap_or(m.push.is_empty()) {
             modes.extend(face_modes(&cells));
         }
         for p in &m.push {
-            modes.push(ContactMode::Translate { point: (p.point[0], p.point[1]), dir: parse_dir(&p.dir, &field("push.dir"))? });
+            modes.push(ContactMode::Translate {
+                point: (p.point[0], p.point[1]),
+                dir: parse_dir(&p.dir, &field("push.dir"))?,
+            });
         }
         for r in &m.rotate {
             let turn = match r.turn.get_ref().as_str() {
                 "cw" => 1,
                 "ccw" => -1,
-                other => return Err(err(r.turn.span(), &field("rotate.turn"), format!("'{other}' is not cw or ccw"))),
+                other => {
+                    return Err(err(
+                        r.turn.span(),
+                        &field("rotate.turn"),
+                        format!("'{other}' is not cw or ccw"),
+                    ));
+                }
             };
             modes.push(ContactMode::Rotate {
                 point: (r.point[0], r.point[1]),
@@ -267,22 +347,41 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError
             });
         }
         let (x, y) = in_grid(&m.at, &field("at"))?;
-        starts.push(Placement { x, y, o: m.orientation });
+        starts.push(Placement {
+            x,
+            y,
+            o: m.orientation,
+        });
         goals.push(match &m.goal {
             Some(g) => {
                 let (gx, gy) = in_grid(g, &field("goal"))?;
-                Some(Placement { x: gx, y: gy, o: m.goal_orientation.unwrap_or(m.orientation) })
+                Some(Placement {
+                    x: gx,
+                    y: gy,
+                    o: m.goal_orientation.unwrap_or(m.orientation),
+                })
             }
             None => None,
         });
-        movables.push(MovableSpec { name, cells, mass: m.mass, rotates: m.rotates, modes });
+        movables.push(MovableSpec {
+            name,
+            cells,
+            mass: m.mass,
+            rotates: m.rotates,
+            modes,
+        });
     }
     let mut push_dirs = 0u8;
     match &f.rules.push_dirs {
         Some(s) => {
             for ch in s.get_ref().chars() {
-                let d = Dir::parse(&ch.to_string())
-                    .ok_or_else(|| err(s.span(), "rules.push_dirs", format!("'{ch}' is not one of N, E, S, W")))?;
+                let d = Dir::parse(&ch.to_string()).ok_or_else(|| {
+                    err(
+                        s.span(),
+                        "rules.push_dirs",
+                        format!("'{ch}' is not one of N, E, S, W"),
+                    )
+                })?;
                 push_dirs |= 1 << d as u8;
             }
         }
@@ -308,7 +407,12 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError
         movables,
         rules,
         metric,
-        start: Config { robot: start_robot, heading, pushing: false, movables: starts },
+        start: Config {
+            robot: start_robot,
+            heading,
+            pushing: false,
+            movables: starts,
+        },
         goal_robot,
         goal_movables: goals,
     })
@@ -318,18 +422,41 @@ pub fn parse_scene(text: &str, default_name: &str) -> Result<Problem, SceneError
 pub const CASES: &[(&str, &str, &str)] = &[
     ("A1", "Fig. 9: one box at a time, mass metric", A1),
     ("A2", "Fig. 10: up to two boxes at once", A2),
-    ("A3", "Fig. 11: two at once, a rough region changes the route", A3),
-    ("A4", "Fig. 12: one at a time, distance limit 7: the robot fetches the second box", A4),
-    ("B1", "Fig. 13: exchanging two boxes needs an intermediate placement", B1),
+    (
+        "A3",
+        "Fig. 11: two at once, a rough region changes the route",
+        A3,
+    ),
+    (
+        "A4",
+        "Fig. 12: one at a time, distance limit 7: the robot fetches the second box",
+        A4,
+    ),
+    (
+        "B1",
+        "Fig. 13: exchanging two boxes needs an intermediate placement",
+        B1,
+    ),
     ("B2", "Fig. 14: a rough region changes the exchange", B2),
-    ("C1", "Fig. 16: a complex movable pushed by a small robot", C1),
-    ("C2", "Fig. 17: the same with a large robot, some pushes no longer fit", C2),
+    (
+        "C1",
+        "Fig. 16: a complex movable pushed by a small robot",
+        C1,
+    ),
+    (
+        "C2",
+        "Fig. 17: the same with a large robot, some pushes no longer fit",
+        C2,
+    ),
     ("D1", "Fig. 19: rotational pushes in clutter", D1),
 ];
 
 /// Load a preset by name (case-insensitive) or a scene file by path.
 pub fn load_scene(name_or_path: &str) -> Result<Problem, SceneError> {
-    if let Some((n, _, text)) = CASES.iter().find(|(n, _, _)| n.eq_ignore_ascii_case(name_or_path)) {
+    if let Some((n, _, text)) = CASES
+        .iter()
+        .find(|(n, _, _)| n.eq_ignore_ascii_case(name_or_path))
+    {
         return parse_scene(text, n);
     }
     let path = std::path::Path::new(name_or_path);

@@ -82,7 +82,11 @@ pub fn cost_map_from(model: &Model, goals: &[u32]) -> Result<CostMap, MapError> 
             queued += 1;
         }
     }
-    let mut stats = MapStats { states_total: n as u64, goals: queued, ..MapStats::default() };
+    let mut stats = MapStats {
+        states_total: n as u64,
+        goals: queued,
+        ..MapStats::default()
+    };
     let mut origins: Vec<(u32, u32)> = Vec::with_capacity(64);
     let mut c: u32 = 0;
     let mut cur: Vec<u32> = Vec::new();

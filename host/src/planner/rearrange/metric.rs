@@ -35,7 +35,12 @@ pub struct Metric {
 
 impl Default for Metric {
     fn default() -> Self {
-        Metric { rough: [1, 1], safety: 0, turn: 0, mode_change: 0 }
+        Metric {
+            rough: [1, 1],
+            safety: 0,
+            turn: 0,
+            mode_change: 0,
+        }
     }
 }
 
@@ -57,7 +62,9 @@ impl Metric {
             return Err("metric.rough factors must be 1..=100".into());
         }
         if self.safety > 1000 || self.turn > 1000 || self.mode_change > 1000 {
-            return Err("metric.safety, metric.turn and metric.mode_change must be 0..=1000".into());
+            return Err(
+                "metric.safety, metric.turn and metric.mode_change must be 0..=1000".into(),
+            );
         }
         Ok(())
     }
@@ -112,9 +119,16 @@ impl Metric {
     /// An upper bound on one move's cost (sizes the bucket queue).
     pub fn max_edge(&self, p: &Problem, robot_cost: &[u32], push_cost: &[Vec<u32>]) -> u32 {
         let r = robot_cost.iter().copied().max().unwrap_or(1);
-        let mut pushes: Vec<u32> = push_cost.iter().map(|v| v.iter().copied().max().unwrap_or(0)).collect();
+        let mut pushes: Vec<u32> = push_cost
+            .iter()
+            .map(|v| v.iter().copied().max().unwrap_or(0))
+            .collect();
         pushes.sort_unstable_by(|a, b| b.cmp(a));
-        let n = if p.rules.max_pushed == 0 { pushes.len() } else { p.rules.max_pushed as usize };
+        let n = if p.rules.max_pushed == 0 {
+            pushes.len()
+        } else {
+            p.rules.max_pushed as usize
+        };
         let m: u32 = pushes.iter().take(n.max(1)).sum();
         r + m + 2 * self.turn + self.mode_change
     }
@@ -134,13 +148,35 @@ mod tests {
 
     #[test]
     fn turn_cost_counts_quarter_turns_and_mode_changes() {
-        let m = Metric { turn: 3, mode_change: 10, ..Metric::default() };
-        assert_eq!(m.memory_cost(Some((Dir::E, false)), Dir::E, StepKind::Transit), 0);
-        assert_eq!(m.memory_cost(Some((Dir::E, false)), Dir::N, StepKind::Transit), 3);
-        assert_eq!(m.memory_cost(Some((Dir::E, false)), Dir::W, StepKind::Transit), 6);
-        assert_eq!(m.memory_cost(Some((Dir::E, true)), Dir::E, StepKind::Translate), 0);
-        assert_eq!(m.memory_cost(Some((Dir::E, false)), Dir::E, StepKind::Translate), 10);
-        assert_eq!(m.memory_cost(Some((Dir::S, true)), Dir::E, StepKind::Translate), 13);
+        let m = Metric {
+            turn: 3,
+            mode_change: 10,
+            ..Metric::default()
+        };
+        assert_eq!(
+            m.memory_cost(Some((Dir::E, false)), Dir::E, StepKind::Transit),
+            0
+        );
+        assert_eq!(
+            m.memory_cost(Some((Dir::E, false)), Dir::N, StepKind::Transit),
+            3
+        );
+        assert_eq!(
+            m.memory_cost(Some((Dir::E, false)), Dir::W, StepKind::Transit),
+            6
+        );
+        assert_eq!(
+            m.memory_cost(Some((Dir::E, true)), Dir::E, StepKind::Translate),
+            0
+        );
+        assert_eq!(
+            m.memory_cost(Some((Dir::E, false)), Dir::E, StepKind::Translate),
+            10
+        );
+        assert_eq!(
+            m.memory_cost(Some((Dir::S, true)), Dir::E, StepKind::Translate),
+            13
+        );
         assert_eq!(m.memory_cost(None, Dir::E, StepKind::Rotate), 0);
     }
 
@@ -149,7 +185,10 @@ mod tests {
         let mut g = Grid::new(3, 1);
         g.at_mut(1, 0).rough = 1;
         g.at_mut(2, 0).rough = 2;
-        let m = Metric { rough: [3, 7], ..Metric::default() };
+        let m = Metric {
+            rough: [3, 7],
+            ..Metric::default()
+        };
         assert_eq!(m.move_cost(2, &[0], &g), 2);
         assert_eq!(m.move_cost(2, &[0, 1], &g), 6);
         assert_eq!(m.move_cost(2, &[1, 2], &g), 14);

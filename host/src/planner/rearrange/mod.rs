@@ -21,11 +21,15 @@ pub mod svg;
 pub use admissibility::{MoveKind, Step};
 pub use costmap::{CostMap, INF, MapError, MapStats, cost_map};
 pub use metric::Metric;
-pub use problem::{Config, ContactMode, Dir, Grid, Model, MovableSpec, Placement, Problem, RobotSpec, Rules};
+pub use problem::{
+    Config, ContactMode, Dir, Grid, Model, MovableSpec, Placement, Problem, RobotSpec, Rules,
+};
 pub use restore::{Plan, RestoreError, restore};
 
 /// Map the problem's goal set and restore the plan from its start: (model, map, plan or why not).
-pub fn solve(problem: &Problem) -> Result<(Model, CostMap, Result<Plan, RestoreError>), SolveError> {
+pub fn solve(
+    problem: &Problem,
+) -> Result<(Model, CostMap, Result<Plan, RestoreError>), SolveError> {
     let model = Model::new(problem)?;
     let map = cost_map(&model)?;
     let start = model.pack(&problem.start).ok_or(SolveError::StartNotFree)?;

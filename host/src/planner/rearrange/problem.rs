@@ -106,7 +106,11 @@ pub struct Grid {
 impl Grid {
     /// An empty table.
     pub fn new(w: i32, h: i32) -> Grid {
-        Grid { w, h, cells: vec![Cell::default(); (w.max(0) * h.max(0)) as usize] }
+        Grid {
+            w,
+            h,
+            cells: vec![Cell::default(); (w.max(0) * h.max(0)) as usize],
+        }
     }
     /// The cell at (x, y), `None` outside.
     pub fn get(&self, x: i32, y: i32) -> Option<&Cell> {
@@ -207,7 +211,13 @@ impl MovableSpec {
     /// A movable with translational contact modes on every face ("faces").
     pub fn with_faces(name: &str, cells: Vec<(i32, i32)>, mass: u32) -> MovableSpec {
         let modes = face_modes(&cells);
-        MovableSpec { name: name.to_string(), cells, mass, rotates: false, modes }
+        MovableSpec {
+            name: name.to_string(),
+            cells,
+            mass,
+            rotates: false,
+            modes,
+        }
     }
     /// The cells at orientation `o`, relative to the anchor.
     pub fn cells_at(&self, o: u8) -> Vec<(i32, i32)> {
@@ -261,7 +271,13 @@ pub struct Rules {
 
 impl Default for Rules {
     fn default() -> Self {
-        Rules { push_dirs: 0b1111, max_pushed: 1, distance_limit: None, strict_contact: true, rotations: true }
+        Rules {
+            push_dirs: 0b1111,
+            max_pushed: 1,
+            distance_limit: None,
+            strict_contact: true,
+            rotations: true,
+        }
     }
 }
 
@@ -357,7 +373,9 @@ pub struct Bits {
 
 impl Bits {
     fn new(n: usize) -> Bits {
-        Bits { words: vec![0; n.div_ceil(64)] }
+        Bits {
+            words: vec![0; n.div_ceil(64)],
+        }
     }
     fn set(&mut self, i: usize) {
         self.words[i >> 6] |= 1 << (i & 63);
@@ -427,6 +445,8 @@ pub struct Model {
     pub radix: Vec<u32>,
     /// Number of packed configurations.
     pub n_states: u64,
+    /// Index stride of each digit: `stride[k] = radix[0] × … × radix[k−1]`.
+    pub stride: Vec<u32>,
     /// Robot/movable overlap: `rm[i].get(r * n_i + m)`.
     pub rm: Vec<Bits>,
     /// Movable/movable overlap for i < j: `mm[i * MAX + j].get(mi * n_j + mj)`.
@@ -471,17 +491,35 @@ fn build_domain(grid: &Grid, shape: &[(i32, i32)], orients: u8) -> Domain {
                 if sh.iter().all(|&(cx, cy)| grid.free(x + cx, y + cy)) {
                     local[o as usize * n + (y * w + x) as usize] = place.len() as u32;
                     place.push(Placement { x, y, o });
-                    cells.push(sh.iter().map(|&(cx, cy)| ((y + cy) * w + x + cx) as u32).collect());
+                    cells.push(
+                        sh.iter()
+                            .map(|&(cx, cy)| ((y + cy) * w + x + cx) as u32)
+                            .collect(),
+                    );
                 }
             }
         }
     }
-    let mut dom = Domain { place, local, orients, shift: Vec::new(), cells };
+    let mut dom = Domain {
+        place,
+        local,
+        orients,
+        shift: Vec::new(),
+        cells,
+    };
     let mut shift = vec![NONE; dom.place.len() * 4];
     for (l, p) in dom.place.iter().enumerate() {
         for d in Dir::ALL {
             let (dx, dy) = d.delta();
-            shift[l * 4 + d as usize] = dom.lookup(w, h, Placement { x: p.x + dx, y: p.y + dy, o: p.o });
+            shift[l * 4 + d as usize] = dom.lookup(
+                w,
+                h,
+                Placement {
+                    x: p.x + dx,
+                    y: p.y + dy,
+                    o: p.o,
+                },
+            );
         }
     }
     dom.shift = shift;
@@ -517,7 +555,10 @@ impl Model {
             return invalid(format!("grid {}×{}: each side must be 1..=256", g.w, g.h));
         }
         if p.movables.len() > MAX_MOVABLES {
-            return invalid(format!("{} movables: at most {MAX_MOVABLES}", p.movables.len()));
+            return invalid(format!(
+                "{} movables: at most {MAX_MOVABLES}",
+                p.movables.len()
+            ));
         }
         if p.robot.size < 1 || p.robot.size > 8 {
             return invalid(format!("robot size {}: must be 1..=8", p.robot.size));
@@ -530,7 +571,10 @@ impl Model {
                 return invalid(format!("movable `{}`: needs 1..=64 cells", m.name));
             }
             if m.cells.iter().any(|&(x, y)| x.abs() > 16 || y.abs() > 16) {
-                return invalid(format!("movable `{}`: cells must lie within 16 of the anchor", m.name));
+                return invalid(format!(
+                    "movable `{}`: cells must lie within 16 of the anchor",
+                    m.name
+                ));
             }
             if m.mass > 1000 {
                 return invalid(format!("movable `{}`: mass must be 0..=1000", m.name));
@@ -538,12 +582,23 @@ impl Model {
             for mode in &m.modes {
                 let (pt, d) = match mode {
                     ContactMode::Translate { point, dir } => (*point, *dir),
-                    ContactMode::Rotate { point, dir, turn, shift } => {
+                    ContactMode::Rotate {
+                        point,
+                        dir,
+                        turn,
+                        shift,
+                    } => {
                         if *turn != 1 && *turn != -1 {
-                            return invalid(format!("movable `{}`: rotation turn must be +1 or -1", m.name));
+                            return invalid(format!(
+                                "movable `{}`: rotation turn must be +1 or -1",
+                                m.name
+                            ));
                         }
                         if shift.0.abs() > 16 || shift.1.abs() > 16 {
-                            return invalid(format!("movable `{}`: rotation shift too large", m.name));
+                            return invalid(format!(
+                                "movable `{}`: rotation shift too large",
+                                m.name
+                            ));
                         }
                         if !m.rotates {
                             return invalid(format!(
@@ -574,33 +629,55 @@ impl Model {
         let n_aux = if metric.needs_memory() { 8 } else { 1 };
         let ncells = (g.w * g.h) as usize;
         let robot = build_domain(g, &p.robot.cells(), 1);
-        let movables: Vec<Domain> =
-            p.movables.iter().map(|m| build_domain(g, &m.cells, if m.rotates { 4 } else { 1 })).collect();
+        let movables: Vec<Domain> = p
+            .movables
+            .iter()
+            .map(|m| build_domain(g, &m.cells, if m.rotates { 4 } else { 1 }))
+            .collect();
         let mut radix = vec![n_aux, robot.len()];
         radix.extend(movables.iter().map(|d| d.len()));
         let n_states: u64 = radix.iter().map(|&r| r as u64).product();
         if n_states >= NONE as u64 {
-            return invalid(format!("{n_states} composite configurations: more than a u32 index holds"));
+            return invalid(format!(
+                "{n_states} composite configurations: more than a u32 index holds"
+            ));
         }
         if radix.contains(&0) {
             return invalid("some body has no free placement on this grid");
         }
-        let rm = movables.iter().map(|d| overlap_table(&robot, d, ncells)).collect();
+        let rm = movables
+            .iter()
+            .map(|d| overlap_table(&robot, d, ncells))
+            .collect();
         let mut mm = vec![None; MAX_MOVABLES * MAX_MOVABLES];
         for i in 0..movables.len() {
             for j in i + 1..movables.len() {
                 mm[i * MAX_MOVABLES + j] = Some(overlap_table(&movables[i], &movables[j], ncells));
             }
         }
-        let robot_cost: Vec<u32> = robot.cells.iter().map(|cs| metric.move_cost(p.robot.mass, cs, g)).collect();
+        let robot_cost: Vec<u32> = robot
+            .cells
+            .iter()
+            .map(|cs| metric.move_cost(p.robot.mass, cs, g))
+            .collect();
         let push_cost: Vec<Vec<u32>> = movables
             .iter()
             .zip(&p.movables)
-            .map(|(d, spec)| d.cells.iter().map(|cs| metric.push_cost(spec.mass, cs, g)).collect())
+            .map(|(d, spec)| {
+                d.cells
+                    .iter()
+                    .map(|cs| metric.push_cost(spec.mass, cs, g))
+                    .collect()
+            })
             .collect();
         let leave_ok = movables
             .iter()
-            .map(|d| d.cells.iter().map(|cs| cs.iter().all(|&c| !g.cells[c as usize].no_leave)).collect())
+            .map(|d| {
+                d.cells
+                    .iter()
+                    .map(|cs| cs.iter().all(|&c| !g.cells[c as usize].no_leave))
+                    .collect()
+            })
             .collect();
         let mut contact = Vec::new();
         let mut rot_pre = Vec::new();
@@ -621,20 +698,45 @@ impl Model {
                             let (pt, d) = (rot(point, o), dir.rotated(o));
                             for a in p.robot.anchors_touching(pt, d) {
                                 let (x, y) = (a.0 - lo, a.1 - lo);
-                                ok[(o as usize * 4 + d as usize) * s2 + (y * side + x) as usize] = true;
+                                ok[(o as usize * 4 + d as usize) * s2 + (y * side + x) as usize] =
+                                    true;
                             }
                         }
-                        ContactMode::Rotate { point, dir, turn, shift } => {
+                        ContactMode::Rotate {
+                            point,
+                            dir,
+                            turn,
+                            shift,
+                        } => {
                             let (pt, d) = (rot(point, o), dir.rotated(o));
                             let post_o = ((o as i32 + turn as i32).rem_euclid(4)) as u8;
                             let sh = rot(shift, o);
                             let mut all: Vec<(i32, i32)> = spec.cells_at(o);
-                            all.extend(spec.cells_at(post_o).iter().map(|&(x, y)| (x + sh.0, y + sh.1)));
-                            let (x0, x1) = (all.iter().map(|c| c.0).min().unwrap_or(0), all.iter().map(|c| c.0).max().unwrap_or(0));
-                            let (y0, y1) = (all.iter().map(|c| c.1).min().unwrap_or(0), all.iter().map(|c| c.1).max().unwrap_or(0));
-                            let sweep: Vec<(i32, i32)> = (y0..=y1).flat_map(|y| (x0..=x1).map(move |x| (x, y))).collect();
+                            all.extend(
+                                spec.cells_at(post_o)
+                                    .iter()
+                                    .map(|&(x, y)| (x + sh.0, y + sh.1)),
+                            );
+                            let (x0, x1) = (
+                                all.iter().map(|c| c.0).min().unwrap_or(0),
+                                all.iter().map(|c| c.0).max().unwrap_or(0),
+                            );
+                            let (y0, y1) = (
+                                all.iter().map(|c| c.1).min().unwrap_or(0),
+                                all.iter().map(|c| c.1).max().unwrap_or(0),
+                            );
+                            let sweep: Vec<(i32, i32)> = (y0..=y1)
+                                .flat_map(|y| (x0..=x1).map(move |x| (x, y)))
+                                .collect();
                             for a in p.robot.anchors_touching(pt, d) {
-                                let inst = RotInstance { pre_o: o, robot_off: a, dir: d, shift: sh, post_o, sweep: sweep.clone() };
+                                let inst = RotInstance {
+                                    pre_o: o,
+                                    robot_off: a,
+                                    dir: d,
+                                    shift: sh,
+                                    post_o,
+                                    sweep: sweep.clone(),
+                                };
                                 pre[o as usize].push(inst.clone());
                                 post[post_o as usize].push(inst);
                             }
@@ -652,13 +754,23 @@ impl Model {
         }
         let max_edge = metric.max_edge(p, &robot_cost, &push_cost);
         if max_edge > 4000 {
-            return invalid(format!("one move may cost {max_edge}: the metric weights are too large (limit 4000)"));
+            return invalid(format!(
+                "one move may cost {max_edge}: the metric weights are too large (limit 4000)"
+            ));
         }
         let model = Model {
             problem: p.clone(),
             n_aux,
             robot,
             movables,
+            stride: radix
+                .iter()
+                .scan(1u32, |acc, &r| {
+                    let s = *acc;
+                    *acc = acc.wrapping_mul(r);
+                    Some(s)
+                })
+                .collect(),
             radix,
             n_states,
             rm,
@@ -672,13 +784,18 @@ impl Model {
             max_edge,
         };
         if model.pack(&p.start).is_none() {
-            return invalid("the start configuration overlaps an obstacle, the grid border or another body");
+            return invalid(
+                "the start configuration overlaps an obstacle, the grid border or another body",
+            );
         }
         for (i, g) in p.goal_movables.iter().enumerate() {
             if let Some(pl) = g
                 && model.movables[i].lookup(model.w(), model.h(), *pl) == NONE
             {
-                return invalid(format!("movable `{}`: its goal overlaps an obstacle", p.movables[i].name));
+                return invalid(format!(
+                    "movable `{}`: its goal overlaps an obstacle",
+                    p.movables[i].name
+                ));
             }
         }
         Ok(model)
@@ -700,7 +817,11 @@ impl Model {
     /// Decode a packed index.
     #[inline]
     pub fn decode(&self, idx: u32) -> State {
-        let mut s = State { aux: 0, r: 0, m: [0; MAX_MOVABLES] };
+        let mut s = State {
+            aux: 0,
+            r: 0,
+            m: [0; MAX_MOVABLES],
+        };
         let mut x = idx;
         s.aux = x % self.radix[0];
         x /= self.radix[0];
@@ -763,7 +884,11 @@ impl Model {
     /// Robot memory index for a last move.
     #[inline]
     pub fn aux_of(&self, dir: Dir, pushing: bool) -> u32 {
-        if self.n_aux == 1 { 0 } else { dir as u32 * 2 + pushing as u32 }
+        if self.n_aux == 1 {
+            0
+        } else {
+            dir as u32 * 2 + pushing as u32
+        }
     }
 
     /// Pack a grid configuration (None if outside CCF).
@@ -772,11 +897,23 @@ impl Model {
             return None;
         }
         let (w, h) = (self.w(), self.h());
-        let r = self.robot.lookup(w, h, Placement { x: c.robot.0, y: c.robot.1, o: 0 });
+        let r = self.robot.lookup(
+            w,
+            h,
+            Placement {
+                x: c.robot.0,
+                y: c.robot.1,
+                o: 0,
+            },
+        );
         if r == NONE {
             return None;
         }
-        let mut s = State { aux: self.aux_of(c.heading, c.pushing), r, m: [0; MAX_MOVABLES] };
+        let mut s = State {
+            aux: self.aux_of(c.heading, c.pushing),
+            r,
+            m: [0; MAX_MOVABLES],
+        };
         for (i, p) in c.movables.iter().enumerate() {
             let l = self.movables[i].lookup(w, h, *p);
             if l == NONE {
@@ -795,7 +932,9 @@ impl Model {
             robot: (rp.x, rp.y),
             heading: Dir::from_index((s.aux / 2) as usize),
             pushing: self.n_aux > 1 && s.aux % 2 == 1,
-            movables: (0..self.r()).map(|i| self.movables[i].place[s.m[i] as usize]).collect(),
+            movables: (0..self.r())
+                .map(|i| self.movables[i].place[s.m[i] as usize])
+                .collect(),
         }
     }
 
@@ -812,10 +951,19 @@ impl Model {
                 None => (0..dom.len()).collect(),
             }
         };
-        let rob = choices(&self.robot, p.goal_robot.map(|(x, y)| Placement { x, y, o: 0 }));
-        let ms: Vec<Vec<u32>> = (0..self.r()).map(|i| choices(&self.movables[i], p.goal_movables[i])).collect();
+        let rob = choices(
+            &self.robot,
+            p.goal_robot.map(|(x, y)| Placement { x, y, o: 0 }),
+        );
+        let ms: Vec<Vec<u32>> = (0..self.r())
+            .map(|i| choices(&self.movables[i], p.goal_movables[i]))
+            .collect();
         let mut out = Vec::new();
-        let mut s = State { aux: 0, r: 0, m: [0; MAX_MOVABLES] };
+        let mut s = State {
+            aux: 0,
+            r: 0,
+            m: [0; MAX_MOVABLES],
+        };
         let mut digits = vec![0usize; self.r()];
         if ms.iter().any(|v| v.is_empty()) {
             return out;
@@ -824,7 +972,8 @@ impl Model {
             for i in 0..self.r() {
                 s.m[i] = ms[i][digits[i]];
             }
-            let movables_ok = (0..self.r()).all(|i| (i + 1..self.r()).all(|j| !self.mm_overlap(i, s.m[i], j, s.m[j])));
+            let movables_ok = (0..self.r())
+                .all(|i| (i + 1..self.r()).all(|j| !self.mm_overlap(i, s.m[i], j, s.m[j])));
             if movables_ok {
                 for &r in &rob {
                     s.r = r;

@@ -35,7 +35,10 @@ pub struct Plan {
 impl Plan {
     /// Number of pushing moves (translational or rotational).
     pub fn pushes(&self) -> usize {
-        self.steps.iter().filter(|s| s.step.kind != MoveKind::Transit).count()
+        self.steps
+            .iter()
+            .filter(|s| s.step.kind != MoveKind::Transit)
+            .count()
     }
 }
 
@@ -67,13 +70,23 @@ pub fn restore(model: &Model, map: &CostMap, start: u32) -> Result<Plan, Restore
     let mut nb = Vec::new();
     while c > 0 {
         model.neighbours(cur, &mut nb);
-        let next = nb.iter().find(|st| st.cost <= c && map.get(st.to) == Some(c - st.cost));
+        let next = nb
+            .iter()
+            .find(|st| st.cost <= c && map.get(st.to) == Some(c - st.cost));
         let Some(&st) = next else {
             return Err(RestoreError::Inconsistent(steps.len()));
         };
-        steps.push(PlanStep { step: st, config: model.unpack(st.to) });
+        steps.push(PlanStep {
+            step: st,
+            config: model.unpack(st.to),
+        });
         cur = st.to;
         c -= st.cost;
     }
-    Ok(Plan { start: model.unpack(start), steps, cost: total, restore_ms: t0.elapsed().as_secs_f64() * 1e3 })
+    Ok(Plan {
+        start: model.unpack(start),
+        steps,
+        cost: total,
+        restore_ms: t0.elapsed().as_secs_f64() * 1e3,
+    })
 }

@@ -20,7 +20,10 @@ pub fn stages(plan: &Plan) -> Vec<std::ops::Range<usize>> {
     let mut start = 0;
     for i in 0..plan.steps.len() {
         let push = plan.steps[i].step.kind != MoveKind::Transit;
-        let next_transit = plan.steps.get(i + 1).is_none_or(|s| s.step.kind == MoveKind::Transit);
+        let next_transit = plan
+            .steps
+            .get(i + 1)
+            .is_none_or(|s| s.step.kind == MoveKind::Transit);
         if (push && next_transit) || i + 1 == plan.steps.len() {
             out.push(start..i + 1);
             start = i + 1;
@@ -31,7 +34,10 @@ pub fn stages(plan: &Plan) -> Vec<std::ops::Range<usize>> {
 
 fn centre(model: &Model, x: i32, y: i32, size: i32) -> (f64, f64) {
     let _ = model;
-    ((x as f64 + size as f64 / 2.0) * CELL, (y as f64 + size as f64 / 2.0) * CELL)
+    (
+        (x as f64 + size as f64 / 2.0) * CELL,
+        (y as f64 + size as f64 / 2.0) * CELL,
+    )
 }
 
 fn draw_movables(s: &mut String, model: &Model, c: &Config, opacity: f64, outline_only: bool) {
@@ -54,7 +60,11 @@ fn draw_movables(s: &mut String, model: &Model, c: &Config, opacity: f64, outlin
         }
         if !outline_only && opacity > 0.5 {
             let (x, y) = ((p.x as f64 + 0.5) * CELL, (p.y as f64 + 0.5) * CELL + 4.0);
-            let _ = write!(s, r#"<text x="{x}" y="{y}" font-size="11" text-anchor="middle" fill="white">{}</text>"#, spec.name);
+            let _ = write!(
+                s,
+                r#"<text x="{x}" y="{y}" font-size="11" text-anchor="middle" fill="white">{}</text>"#,
+                spec.name
+            );
         }
     }
 }
@@ -97,7 +107,13 @@ fn panel(s: &mut String, model: &Model, before: &Config, steps: &[&Config], titl
         heading: before.heading,
         pushing: false,
         movables: (0..model.r())
-            .map(|i| model.problem.goal_movables[i].unwrap_or(super::problem::Placement { x: -100, y: -100, o: 0 }))
+            .map(|i| {
+                model.problem.goal_movables[i].unwrap_or(super::problem::Placement {
+                    x: -100,
+                    y: -100,
+                    o: 0,
+                })
+            })
             .collect(),
     };
     draw_movables(s, model, &goal, 1.0, true);
@@ -114,7 +130,10 @@ fn panel(s: &mut String, model: &Model, before: &Config, steps: &[&Config], titl
             r##"<polyline points="{d}" fill="none" stroke="#1c7ed6" stroke-width="2" marker-end="url(#arrow)"/>"##
         );
     }
-    let (rx, ry) = (last.robot.0 as f64 * CELL + 2.0, last.robot.1 as f64 * CELL + 2.0);
+    let (rx, ry) = (
+        last.robot.0 as f64 * CELL + 2.0,
+        last.robot.1 as f64 * CELL + 2.0,
+    );
     let side = k as f64 * CELL - 4.0;
     let _ = write!(
         s,
@@ -142,7 +161,13 @@ pub fn plan_svg(model: &Model, plan: &Plan) -> String {
     let mut before = plan.start.clone();
     if st.is_empty() {
         let _ = write!(s, r#"<g transform="translate({PAD},{})">"#, PAD + 14.0);
-        panel(&mut s, model, &before, &[], &format!("{}: already at the goal", model.problem.name));
+        panel(
+            &mut s,
+            model,
+            &before,
+            &[],
+            &format!("{}: already at the goal", model.problem.name),
+        );
         s.push_str("</g>");
     }
     for (n, range) in st.iter().enumerate() {
@@ -153,9 +178,21 @@ pub fn plan_svg(model: &Model, plan: &Plan) -> String {
             col as f64 * pw + PAD,
             row as f64 * ph + PAD + 14.0
         );
-        let cfgs: Vec<&Config> = plan.steps[range.clone()].iter().map(|p| &p.config).collect();
-        let pushes = plan.steps[range.clone()].iter().filter(|p| p.step.kind != MoveKind::Transit).count();
-        let title = format!("{} step {}: {} moves, {} pushes", model.problem.name, n + 1, range.len(), pushes);
+        let cfgs: Vec<&Config> = plan.steps[range.clone()]
+            .iter()
+            .map(|p| &p.config)
+            .collect();
+        let pushes = plan.steps[range.clone()]
+            .iter()
+            .filter(|p| p.step.kind != MoveKind::Transit)
+            .count();
+        let title = format!(
+            "{} step {}: {} moves, {} pushes",
+            model.problem.name,
+            n + 1,
+            range.len(),
+            pushes
+        );
         panel(&mut s, model, &before, &cfgs, &title);
         s.push_str("</g>");
         if let Some(c) = cfgs.last() {
