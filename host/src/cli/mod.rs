@@ -7,6 +7,8 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+pub mod rearrange;
+
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
 pub struct Global {
@@ -33,7 +35,28 @@ pub struct Cli {
 
 /// The commands.
 #[derive(Subcommand, Debug)]
-pub enum Command {}
+pub enum Command {
+    /// Plan a task without running it.
+    #[command(subcommand)]
+    Plan(PlanCommand),
+    /// Measure a planner.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `pushbot plan …`.
+#[derive(Subcommand, Debug)]
+pub enum PlanCommand {
+    /// Rearrange movables by pushing, optimally (Ben-Shahar & Rivlin).
+    Rearrange(rearrange::PlanArgs),
+}
+
+/// `pushbot bench …`.
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Cost-map building of the rearrangement planner on large rooms.
+    Rearrange(rearrange::BenchArgs),
+}
 
 /// How a command that ran to its end went.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,6 +125,8 @@ fn init_logging(verbose: u8) {
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
-    let _ = &global;
-    match command {}
+    match command {
+        Command::Plan(PlanCommand::Rearrange(args)) => rearrange::plan(&global, args),
+        Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
+    }
 }

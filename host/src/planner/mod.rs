@@ -1,0 +1,3 @@
+//! Planners: how the robot moves objects by pushing.
+
+pub mod rearrange;
