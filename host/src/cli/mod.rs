@@ -7,6 +7,8 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+pub mod stable;
+
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
 pub struct Global {
@@ -33,7 +35,30 @@ pub struct Cli {
 
 /// The commands.
 #[derive(Subcommand, Debug)]
-pub enum Command {}
+pub enum Command {
+    /// Pushing mechanics of an object: STABLE per edge, controllability (Lynch & Mason §3).
+    Mechanics(stable::MechanicsArgs),
+    /// Plan.
+    #[command(subcommand)]
+    Plan(Plan),
+    /// Benchmarks.
+    #[command(subcommand)]
+    Bench(Bench),
+}
+
+/// `pushbot plan …`.
+#[derive(Subcommand, Debug)]
+pub enum Plan {
+    /// Stable pushing among obstacles (Lynch & Mason §4).
+    Stable(stable::PlanStableArgs),
+}
+
+/// `pushbot bench …`.
+#[derive(Subcommand, Debug)]
+pub enum Bench {
+    /// Plan time of the stable-pushing presets next to the paper's.
+    Stable(stable::BenchStableArgs),
+}
 
 /// How a command that ran to its end went.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,6 +127,9 @@ fn init_logging(verbose: u8) {
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
-    let _ = &global;
-    match command {}
+    match command {
+        Command::Mechanics(a) => stable::run_mechanics(&global, &a),
+        Command::Plan(Plan::Stable(a)) => stable::run_plan(&global, &a),
+        Command::Bench(Bench::Stable(a)) => stable::run_bench(&global, &a),
+    }
 }
