@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 
 pub mod rearrange;
+pub mod stable;
 
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
@@ -36,10 +37,12 @@ pub struct Cli {
 /// The commands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Pushing mechanics of an object: STABLE per edge, controllability (Lynch & Mason §3).
+    Mechanics(stable::MechanicsArgs),
     /// Plan a task without running it.
     #[command(subcommand)]
     Plan(PlanCommand),
-    /// Measure a planner.
+    /// Measure planners and pipelines; prints numbers.
     #[command(subcommand)]
     Bench(BenchCommand),
 }
@@ -49,6 +52,8 @@ pub enum Command {
 pub enum PlanCommand {
     /// Rearrange movables by pushing, optimally (Ben-Shahar & Rivlin).
     Rearrange(rearrange::PlanArgs),
+    /// Stable pushing among obstacles (Lynch & Mason §4).
+    Stable(stable::PlanStableArgs),
 }
 
 /// `pushbot bench …`.
@@ -56,6 +61,8 @@ pub enum PlanCommand {
 pub enum BenchCommand {
     /// Cost-map building of the rearrangement planner on large rooms.
     Rearrange(rearrange::BenchArgs),
+    /// Plan time of the stable-pushing presets next to the paper's.
+    Stable(stable::BenchStableArgs),
 }
 
 /// How a command that ran to its end went.
@@ -126,7 +133,10 @@ fn init_logging(verbose: u8) {
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
     match command {
+        Command::Mechanics(a) => stable::run_mechanics(&global, &a),
         Command::Plan(PlanCommand::Rearrange(args)) => rearrange::plan(&global, args),
+        Command::Plan(PlanCommand::Stable(a)) => stable::run_plan(&global, &a),
         Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
+        Command::Bench(BenchCommand::Stable(a)) => stable::run_bench(&global, &a),
     }
 }
