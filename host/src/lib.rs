@@ -5,5 +5,6 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod link;
 pub mod mechanics;
 pub mod planner;

@@ -254,8 +254,14 @@ impl Runner {
     fn run(mut self) -> Result<()> {
         // Sleep only when ahead of the wall clock by at least this much (bounds wake-ups).
         const SLACK: Duration = Duration::from_millis(1);
-        // Behind by more than this, give up catching up: the sim runs slower than asked.
-        const MAX_LAG: Duration = Duration::from_millis(200);
+        // Behind by more than this much wall time, give up catching up: the sim runs slower
+        // than asked rather than in a burst. The bound is 20 ms of *robot* time, so a burst
+        // never comes near the link watchdog (≥ 50 ms) while the host is still answering.
+        let max_lag = Duration::from_secs_f64(if self.speed > 0.0 {
+            (0.02 / self.speed).min(0.2)
+        } else {
+            0.2
+        });
         let tick_us = u64::from(self.sim.tick_us());
         let mut wall0 = Instant::now();
         let sim0 = self.sim.now_us();
@@ -286,7 +292,7 @@ impl Runner {
                         .wait_readable((due - now).min(Duration::from_millis(50)))?;
                     continue;
                 }
-                if now > due + MAX_LAG {
+                if now > due + max_lag {
                     wall0 += now - due;
                 }
             }

@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 
 pub mod rearrange;
+pub mod robot;
 pub mod stable;
 
 /// Flags every command takes.
@@ -37,6 +38,8 @@ pub struct Cli {
 /// The commands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Talk to the robot: info, move, spin, stop, estop, clear-faults.
+    Robot(robot::RobotArgs),
     /// Pushing mechanics of an object: STABLE per edge, controllability (Lynch & Mason §3).
     Mechanics(stable::MechanicsArgs),
     /// Plan a task without running it.
@@ -133,6 +136,7 @@ fn init_logging(verbose: u8) {
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
     match command {
+        Command::Robot(args) => robot::run(&global, args),
         Command::Mechanics(a) => stable::run_mechanics(&global, &a),
         Command::Plan(PlanCommand::Rearrange(args)) => rearrange::plan(&global, args),
         Command::Plan(PlanCommand::Stable(a)) => stable::run_plan(&global, &a),
