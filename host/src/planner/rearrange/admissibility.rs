@@ -292,6 +292,7 @@ impl Model {
         // Origins differ from Q in a few digits: build their indices by strides, not by encoding.
         let base = idx - q.aux;
         let sr = self.stride[1];
+        let touching = (0..n).any(|i| self.touch[i].get(q.r as usize * self.radix[2 + i] as usize + q.m[i] as usize));
         for &d in dirs {
             let rh = self.robot.shift[q.r as usize * 4 + d.opposite() as usize];
             if rh == NONE {
@@ -309,7 +310,7 @@ impl Model {
                     }
                 }
             }
-            if !push_ok || self.problem.rules.push_dirs & (1 << d as u8) == 0 {
+            if !touching || !push_ok || self.problem.rules.push_dirs & (1 << d as u8) == 0 {
                 continue;
             }
             // Movables the robot may have run into: undone by one cell, under the robot's new cells.
@@ -348,7 +349,7 @@ impl Model {
                 }
             }
         }
-        if !transit_ok {
+        if !transit_ok || !self.any_rotation {
             return;
         }
         for i in 0..n {
