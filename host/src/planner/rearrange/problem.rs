@@ -447,7 +447,8 @@ pub struct Model {
     pub n_states: u64,
     /// Index stride of each digit: `stride[k] = radix[0] × … × radix[k−1]`.
     pub stride: Vec<u32>,
-    /// Robot/movable overlap: `rm[i].get(r * n_i + m)`.
+    /// Robot/movable overlap: `rm[i].get(m * n_robot + r)` (movable-major, so the robot's
+    /// neighbouring placements share cache lines).
     pub rm: Vec<Bits>,
     /// Robot/movable contact (a robot cell and a movable cell side by side): `touch[i]`, same
     /// layout as `rm`. No push can have led to a configuration where the robot touches nothing.
@@ -678,9 +679,9 @@ impl Model {
         }
         let rm = movables
             .iter()
-            .map(|d| overlap_table(&robot, d, ncells))
+            .map(|d| overlap_table(d, &robot, ncells))
             .collect();
-        let touch = movables.iter().map(|d| touch_table(&robot, d, g)).collect();
+        let touch = movables.iter().map(|d| touch_table(d, &robot, g)).collect();
         let mut mm = vec![None; MAX_MOVABLES * MAX_MOVABLES];
         for i in 0..movables.len() {
             for j in i + 1..movables.len() {
@@ -885,7 +886,7 @@ impl Model {
     /// Are the two bodies overlapping? (robot vs movable i)
     #[inline]
     pub fn rm_overlap(&self, i: usize, r: u32, m: u32) -> bool {
-        self.rm[i].get(r as usize * self.radix[2 + i] as usize + m as usize)
+        self.rm[i].get(m as usize * self.radix[1] as usize + r as usize)
     }
 
     /// Are movables i and j (i ≠ j) overlapping?
