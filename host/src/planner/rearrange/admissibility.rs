@@ -19,6 +19,9 @@
 //! Origins are found by undoing each kind of move and then replaying the forward move from the
 //! candidate: a candidate Q̂ is an origin of Q exactly when the forward move from Q̂ lands on Q.
 
+// Movable indices address several parallel arrays (placements, tables, masks) at once.
+#![allow(clippy::needless_range_loop)]
+
 use super::metric::StepKind;
 use super::problem::{Dir, MAX_MOVABLES, Model, NONE, RotInstance, State};
 
@@ -286,12 +289,18 @@ impl Model {
             (&Dir::ALL, true, true)
         } else {
             let d = (q.aux / 2) as usize;
-            (&Dir::ALL[d..d + 1], q.aux % 2 == 0, q.aux % 2 == 1)
+            (
+                &Dir::ALL[d..d + 1],
+                q.aux.is_multiple_of(2),
+                !q.aux.is_multiple_of(2),
+            )
         };
         let transit_arrival = transit_ok && self.arrival_ok(q.r, &q.m, 0);
         // Origins differ from Q in a few digits: build their indices by strides, not by encoding.
         let base = idx - q.aux;
         let sr = self.stride[1];
+        let touching = (0..n)
+            .any(|i| self.touch[i].get(q.m[i] as usize * self.radix[1] as usize + q.r as usize));
         for &d in dirs {
             let rh = self.robot.shift[q.r as usize * 4 + d.opposite() as usize];
             if rh == NONE {
@@ -309,7 +318,7 @@ impl Model {
                     }
                 }
             }
-            if !push_ok || self.problem.rules.push_dirs & (1 << d as u8) == 0 {
+            if !touching || !push_ok || self.problem.rules.push_dirs & (1 << d as u8) == 0 {
                 continue;
             }
             // Movables the robot may have run into: undone by one cell, under the robot's new cells.
@@ -348,7 +357,7 @@ impl Model {
                 }
             }
         }
-        if !transit_ok {
+        if !transit_ok || !self.any_rotation {
             return;
         }
         for i in 0..n {

@@ -15,6 +15,9 @@ use super::problem::Model;
 /// Cost of a configuration the wave never reached (no pushing path, CCO, trap points).
 pub const INF: u16 = u16::MAX;
 
+/// Buckets larger than this are sorted by index before they are expanded.
+const SORT_MIN: usize = 4096;
+
 /// Numbers about one cost mapping.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct MapStats {
@@ -94,6 +97,11 @@ pub fn cost_map_from(model: &Model, goals: &[u32]) -> Result<CostMap, MapError> 
         let b = c as usize % ring;
         std::mem::swap(&mut cur, &mut buckets[b]);
         queued -= cur.len() as u64;
+        // Entries of one cost are scattered over the map; in index order they sweep it once,
+        // so the cache misses of the settled-check and of nearby origins are shared.
+        if cur.len() > SORT_MIN {
+            cur.sort_unstable();
+        }
         for &q in &cur {
             if cost[q as usize] as u32 != c {
                 continue; // stale: settled earlier with a lower cost

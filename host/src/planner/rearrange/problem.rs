@@ -447,8 +447,14 @@ pub struct Model {
     pub n_states: u64,
     /// Index stride of each digit: `stride[k] = radix[0] × … × radix[k−1]`.
     pub stride: Vec<u32>,
-    /// Robot/movable overlap: `rm[i].get(r * n_i + m)`.
+    /// Robot/movable overlap: `rm[i].get(m * n_robot + r)` (movable-major, so the robot's
+    /// neighbouring placements share cache lines).
     pub rm: Vec<Bits>,
+    /// Robot/movable contact (a robot cell and a movable cell side by side): `touch[i]`, same
+    /// layout as `rm`. No push can have led to a configuration where the robot touches nothing.
+    pub touch: Vec<Bits>,
+    /// Some movable has rotational pushes.
+    pub any_rotation: bool,
     /// Movable/movable overlap for i < j: `mm[i * MAX + j].get(mi * n_j + mj)`.
     pub mm: Vec<Option<Bits>>,
     /// Cost of the robot arriving at a placement (mass × passability).
@@ -524,6 +530,32 @@ fn build_domain(grid: &Grid, shape: &[(i32, i32)], orients: u8) -> Domain {
     }
     dom.shift = shift;
     dom
+}
+
+fn touch_table(a: &Domain, b: &Domain, grid: &Grid) -> Bits {
+    let ncells = (grid.w * grid.h) as usize;
+    let mut cover: Vec<Vec<u32>> = vec![Vec::new(); ncells];
+    for (l, cs) in b.cells.iter().enumerate() {
+        for &c in cs {
+            cover[c as usize].push(l as u32);
+        }
+    }
+    let nb = b.len() as usize;
+    let mut bits = Bits::new(a.len() as usize * nb);
+    for (la, cs) in a.cells.iter().enumerate() {
+        for &c in cs {
+            let (x, y) = (c as i32 % grid.w, c as i32 / grid.w);
+            for d in Dir::ALL {
+                let (dx, dy) = d.delta();
+                if grid.get(x + dx, y + dy).is_some() {
+                    for &lb in &cover[((y + dy) * grid.w + x + dx) as usize] {
+                        bits.set(la * nb + lb as usize);
+                    }
+                }
+            }
+        }
+    }
+    bits
 }
 
 fn overlap_table(a: &Domain, b: &Domain, ncells: usize) -> Bits {
@@ -647,8 +679,9 @@ impl Model {
         }
         let rm = movables
             .iter()
-            .map(|d| overlap_table(&robot, d, ncells))
+            .map(|d| overlap_table(d, &robot, ncells))
             .collect();
+        let touch = movables.iter().map(|d| touch_table(d, &robot, g)).collect();
         let mut mm = vec![None; MAX_MOVABLES * MAX_MOVABLES];
         for i in 0..movables.len() {
             for j in i + 1..movables.len() {
@@ -752,6 +785,7 @@ impl Model {
             rot_pre.push(pre);
             rot_post.push(post);
         }
+        let any_rotation = rot_post.iter().any(|r| r.iter().any(|v| !v.is_empty()));
         let max_edge = metric.max_edge(p, &robot_cost, &push_cost);
         if max_edge > 4000 {
             return invalid(format!(
@@ -774,6 +808,8 @@ impl Model {
             radix,
             n_states,
             rm,
+            touch,
+            any_rotation,
             mm,
             robot_cost,
             push_cost,
@@ -823,8 +859,10 @@ impl Model {
             m: [0; MAX_MOVABLES],
         };
         let mut x = idx;
-        s.aux = x % self.radix[0];
-        x /= self.radix[0];
+        if self.n_aux > 1 {
+            s.aux = x % self.radix[0];
+            x /= self.radix[0];
+        }
         s.r = x % self.radix[1];
         x /= self.radix[1];
         for i in 0..self.r() {
@@ -848,7 +886,7 @@ impl Model {
     /// Are the two bodies overlapping? (robot vs movable i)
     #[inline]
     pub fn rm_overlap(&self, i: usize, r: u32, m: u32) -> bool {
-        self.rm[i].get(r as usize * self.radix[2 + i] as usize + m as usize)
+        self.rm[i].get(m as usize * self.radix[1] as usize + r as usize)
     }
 
     /// Are movables i and j (i ≠ j) overlapping?
