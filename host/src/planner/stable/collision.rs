@@ -224,7 +224,8 @@ impl Body {
             if d <= CONTACT_EPS {
                 return false;
             }
-            if t >= 1.0 {
+            // Nothing can close the remaining gap before the step ends.
+            if t >= 1.0 || d - reach * (1.0 - t) > CONTACT_EPS {
                 return true;
             }
             // d is a lower bound only for obstacles inside the broad phase; those outside are

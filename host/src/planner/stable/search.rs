@@ -12,6 +12,7 @@
 //! goal exactly.
 
 use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
 use super::collision;
@@ -20,6 +21,33 @@ use super::{Pose, Problem};
 use crate::mechanics::V3;
 
 const NONE: u32 = u32::MAX;
+
+/// A small multiplicative hasher for the pruning grid's integer keys (SipHash is the search's
+/// bottleneck otherwise).
+#[derive(Default)]
+struct GridHasher(u64);
+
+impl Hasher for GridHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(u64::from(*b));
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+}
+
+type GridSet = HashSet<(i64, i64, i64, u32), BuildHasherDefault<GridHasher>>;
 
 /// One push step of a plan.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -140,7 +168,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     }];
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
-    let mut occupied: HashSet<(i64, i64, i64, u32)> = HashSet::new();
+    let mut occupied: GridSet = GridSet::default();
     let max_cost = p.params.max_cost as usize;
     let mut buckets: Vec<std::collections::VecDeque<u32>> = vec![Default::default(); max_cost + 1];
     let mut heap: BinaryHeap<std::cmp::Reverse<(u32, u32)>> = BinaryHeap::new();
