@@ -357,8 +357,8 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
     {
         bail!("planner.fine_radius_frac: must be finite and >= 0, got {v}");
     }
-    if p.max_cost.is_some_and(|m| m > 10_000_000) {
-        bail!("planner.max_cost: at most 10000000");
+    if p.max_cost.is_some_and(|m| m > 1_000_000) {
+        bail!("planner.max_cost: at most 1000000");
     }
     match s.pusher.kind.as_str() {
         "arm" | "omni" | "car" | "diff-drive" => {}

@@ -141,14 +141,15 @@ pub fn step_cost(
     control: usize,
 ) -> Option<u32> {
     let mut c = p.params.a;
+    // Saturating: costs come from the command line.
     if let Some((pc, pk)) = prev {
         // `pk == usize::MAX`: the pusher waits at its start contact, no control yet; leaving
         // that contact is still a contact (and so a control) change.
         if (pc, pk) != (contact, control) && (pk != usize::MAX || pc != contact) {
-            c += p.params.b;
+            c = c.saturating_add(p.params.b);
         }
         if pc != contact {
-            c += p.params.c?;
+            c = c.saturating_add(p.params.c?);
         }
     }
     Some(c)
@@ -253,7 +254,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
                 };
-                let cost = n.cost + dc;
+                let cost = n.cost.saturating_add(dc);
                 if cost > p.params.max_cost {
                     continue;
                 }
@@ -339,7 +340,7 @@ pub fn summarise(p: &Problem, plan: &mut Plan) {
                 plan.contact_changes += 1;
             }
         }
-        cost += step_cost(p, prev, s.contact, s.control).unwrap_or(0);
+        cost = cost.saturating_add(step_cost(p, prev, s.contact, s.control).unwrap_or(0));
         prev = Some((s.contact, s.control));
     }
     plan.cost = cost;
@@ -459,7 +460,9 @@ pub fn brute_force_cost(p: &Problem, depth: usize) -> Option<u32> {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
                 };
-                if cost + dc > p.params.max_cost || !cm.body.step_free(&p.world, &q, xi) {
+                if cost.saturating_add(dc) > p.params.max_cost
+                    || !cm.body.step_free(&p.world, &q, xi)
+                {
                     continue;
                 }
                 rec(
