@@ -4,15 +4,20 @@
 use std::f64::consts::PI;
 
 use pushbot::mechanics::controllability::{
-    PushBoundary, controllable, positively_spans_space, small_time_locally_controllable, theorem2_edge,
-    theorem2_vertex, theorem3, theorem5, theorem6, theorem7,
+    PushBoundary, controllable, positively_spans_space, small_time_locally_controllable,
+    theorem2_edge, theorem2_vertex, theorem3, theorem5, theorem6, theorem7,
 };
 use pushbot::mechanics::limit_surface::EllipsoidLimitSurface;
 use pushbot::mechanics::stable::{StableSet, stable};
 use pushbot::mechanics::{LineContact, Slider, V2, V3, cor};
 
 fn square() -> Slider {
-    let o = [V2::new(-1.0, -1.0), V2::new(1.0, -1.0), V2::new(1.0, 1.0), V2::new(-1.0, 1.0)];
+    let o = [
+        V2::new(-1.0, -1.0),
+        V2::new(1.0, -1.0),
+        V2::new(1.0, 1.0),
+        V2::new(-1.0, 1.0),
+    ];
     Slider::new(&o, V2::zeros()).unwrap()
 }
 
@@ -27,7 +32,12 @@ fn regular(n: usize, r: f64) -> Slider {
 }
 
 fn rect(w: f64, h: f64, cof: V2) -> Slider {
-    let o = [V2::new(0.0, 0.0), V2::new(w, 0.0), V2::new(w, h), V2::new(0.0, h)];
+    let o = [
+        V2::new(0.0, 0.0),
+        V2::new(w, 0.0),
+        V2::new(w, h),
+        V2::new(0.0, h),
+    ];
     Slider::new(&o, cof).unwrap()
 }
 
@@ -35,7 +45,10 @@ fn same_set(got: &[V3], want: &[V3]) {
     assert_eq!(got.len(), want.len(), "got {got:?}, want {want:?}");
     for w in want {
         let w = w.normalize();
-        assert!(got.iter().any(|g| (g - w).norm() < 1e-9), "missing {w:?} in {got:?}");
+        assert!(
+            got.iter().any(|g| (g - w).norm() < 1e-9),
+            "missing {w:?} in {got:?}"
+        );
     }
 }
 
@@ -56,7 +69,12 @@ fn stable_square_mu_half_hand_computed() {
     let set = stable(&s, &LineContact::full_edge(&s, 0).unwrap(), 0.5).unwrap();
     same_set(
         &set.extremal,
-        &[V3::new(0.0, 3.0, 1.0), V3::new(0.0, 3.0, -1.0), V3::new(-1.0, 2.0, 0.0), V3::new(1.0, 2.0, 0.0)],
+        &[
+            V3::new(0.0, 3.0, 1.0),
+            V3::new(0.0, 3.0, -1.0),
+            V3::new(-1.0, 2.0, 0.0),
+            V3::new(1.0, 2.0, 0.0),
+        ],
     );
     let cors: Vec<V2> = set.extremal_cors().into_iter().flatten().collect();
     assert!(cors.iter().any(|c| (c - V2::new(-3.0, 0.0)).norm() < 1e-9));
@@ -78,7 +96,12 @@ fn stable_square_mu_ten_end_point_bands_bind() {
     let set = stable(&s, &LineContact::full_edge(&s, 0).unwrap(), 10.0).unwrap();
     same_set(
         &set.extremal,
-        &[V3::new(0.5, 1.5, 1.0), V3::new(-0.5, 1.5, -1.0), V3::new(1.0, 1.0, 0.0), V3::new(-1.0, 1.0, 0.0)],
+        &[
+            V3::new(0.5, 1.5, 1.0),
+            V3::new(-0.5, 1.5, -1.0),
+            V3::new(1.0, 1.0, 0.0),
+            V3::new(-1.0, 1.0, 0.0),
+        ],
     );
 }
 
@@ -89,10 +112,15 @@ fn stable_is_frame_independent() {
     let s = square();
     let top = stable(&s, &LineContact::full_edge(&s, 2).unwrap(), 0.5).unwrap();
     // Edge 2 runs from (1,1) to (−1,1), normal −y: the bottom-edge set rotated by π.
-    let want: Vec<V3> = [V3::new(0.0, 3.0, 1.0), V3::new(0.0, 3.0, -1.0), V3::new(-1.0, 2.0, 0.0), V3::new(1.0, 2.0, 0.0)]
-        .iter()
-        .map(|v| V3::new(-v.x, -v.y, v.z))
-        .collect();
+    let want: Vec<V3> = [
+        V3::new(0.0, 3.0, 1.0),
+        V3::new(0.0, 3.0, -1.0),
+        V3::new(-1.0, 2.0, 0.0),
+        V3::new(1.0, 2.0, 0.0),
+    ]
+    .iter()
+    .map(|v| V3::new(-v.x, -v.y, v.z))
+    .collect();
     same_set(&top.extremal, &want);
 }
 
@@ -100,7 +128,12 @@ fn stable_is_frame_independent() {
 /// change the extremal set on these cases, and every rotation centre found lies outside them.
 #[test]
 fn theorem4_lines_are_redundant_on_polygons() {
-    for (s, mu) in [(square(), 0.5), (square(), 10.0), (rect(3.0, 1.0, V2::new(1.2, 0.4)), 0.3), (regular(6, 1.0), 0.8)] {
+    for (s, mu) in [
+        (square(), 0.5),
+        (square(), 10.0),
+        (rect(3.0, 1.0, V2::new(1.2, 0.4)), 0.3),
+        (regular(6, 1.0), 0.8),
+    ] {
         for e in 0..s.n_edges() {
             let c = LineContact::full_edge(&s, e).unwrap();
             let set = stable(&s, &c, mu).unwrap();
@@ -110,12 +143,23 @@ fn theorem4_lines_are_redundant_on_polygons() {
                 extremal: pushbot::mechanics::stable::extreme_rays(&set.constraints[..8]),
             };
             same_set(&without.extremal, &set.extremal);
-            let xs: Vec<f64> = s.vertices.iter().map(|v| c.to_contact_frame(*v).x).collect();
-            let (xmin, xmax) = (xs.iter().copied().fold(f64::INFINITY, f64::min), xs.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+            let xs: Vec<f64> = s
+                .vertices
+                .iter()
+                .map(|v| c.to_contact_frame(*v).x)
+                .collect();
+            let (xmin, xmax) = (
+                xs.iter().copied().fold(f64::INFINITY, f64::min),
+                xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            );
             for v in &set.extremal {
                 if let Some(k) = cor(v) {
                     let kx = c.to_contact_frame(k).x;
-                    if v.z > 0.0 { assert!(kx <= xmin + 1e-9) } else { assert!(kx >= xmax - 1e-9) }
+                    if v.z > 0.0 {
+                        assert!(kx <= xmin + 1e-9)
+                    } else {
+                        assert!(kx >= xmax - 1e-9)
+                    }
                 }
             }
         }
@@ -127,7 +171,11 @@ fn theorem4_lines_are_redundant_on_polygons() {
 /// returns lies in the composite friction cone of the line contact (§3.3.1, Fig. 9).
 #[test]
 fn stable_directions_need_forces_inside_the_composite_cone() {
-    for (s, mu) in [(square(), 0.5), (rect(3.0, 1.0, V2::new(1.2, 0.4)), 0.3), (regular(8, 1.0), 1.0)] {
+    for (s, mu) in [
+        (square(), 0.5),
+        (rect(3.0, 1.0, V2::new(1.2, 0.4)), 0.3),
+        (regular(8, 1.0), 1.0),
+    ] {
         let r = s.radius();
         for e in 0..s.n_edges() {
             let c = LineContact::full_edge(&s, e).unwrap();
@@ -137,7 +185,11 @@ fn stable_directions_need_forces_inside_the_composite_cone() {
             let edges = [n * a.cos() - t * a.sin(), n * a.cos() + t * a.sin()];
             let gens: Vec<V3> = [c.a, c.b]
                 .iter()
-                .flat_map(|p| edges.iter().map(move |d| V3::new(d.x, d.y, p.x * d.y - p.y * d.x)))
+                .flat_map(|p| {
+                    edges
+                        .iter()
+                        .map(move |d| V3::new(d.x, d.y, p.x * d.y - p.y * d.x))
+                })
                 .collect();
             // Facets of the composite cone (pointed): planes through two generators with all
             // generators on one side.
@@ -157,14 +209,19 @@ fn stable_directions_need_forces_inside_the_composite_cone() {
                 }
             }
             for frac in [0.3, 0.5, 0.7, 1.0] {
-                let ls = EllipsoidLimitSurface { c: frac * r / 2f64.sqrt() };
+                let ls = EllipsoidLimitSurface {
+                    c: frac * r / 2f64.sqrt(),
+                };
                 let k = set.extremal.len();
                 for i in 0..k {
                     for w in [0.0, 0.3, 0.7] {
                         let v = set.extremal[i] * (1.0 - w) + set.extremal[(i + 1) % k] * w;
                         let f = ls.force(&v);
                         for fa in &facets {
-                            assert!(fa.dot(&f) >= -1e-7, "edge {e}, c={frac}: force {f:?} outside F");
+                            assert!(
+                                fa.dot(&f) >= -1e-7,
+                                "edge {e}, c={frac}: force {f:?} outside F"
+                            );
                         }
                     }
                 }
@@ -178,7 +235,11 @@ fn stable_directions_need_forces_inside_the_composite_cone() {
 #[test]
 fn no_pure_force_no_stable_push() {
     let s = square();
-    let c = LineContact { edge: 0, a: V2::new(0.5, -1.0), b: V2::new(1.0, -1.0) };
+    let c = LineContact {
+        edge: 0,
+        a: V2::new(0.5, -1.0),
+        b: V2::new(1.0, -1.0),
+    };
     let set = stable(&s, &c, 0.1).unwrap();
     assert!(set.is_empty(), "{:?}", set.extremal);
     assert!(!theorem5(&c, 0.1));
@@ -207,7 +268,11 @@ fn rectangles_and_regular_2k_gons_are_stlc_from_two_opposite_edges() {
             assert!(theorem7(&[c1, c2], mu), "Theorem 7 on {:?}", s.vertices);
             let mut dirs = stable(s, &c1, mu).unwrap().extremal;
             dirs.extend(stable(s, &c2, mu).unwrap().extremal);
-            assert!(small_time_locally_controllable(&dirs), "Prop 4 on {:?} mu {mu}", s.vertices);
+            assert!(
+                small_time_locally_controllable(&dirs),
+                "Prop 4 on {:?} mu {mu}",
+                s.vertices
+            );
             // One edge alone: controllable (Theorem 5, Proposition 2) but not STLC (it cannot pull).
             let one = stable(s, &c1, mu).unwrap().extremal;
             assert!(theorem5(&c1, mu) && controllable(&one));
@@ -225,13 +290,18 @@ fn rectangles_and_regular_2k_gons_are_stlc_from_two_opposite_edges() {
 #[test]
 fn adjacent_edges_are_not_stlc() {
     let s = square();
-    let cs = [LineContact::full_edge(&s, 0).unwrap(), LineContact::full_edge(&s, 1).unwrap()];
+    let cs = [
+        LineContact::full_edge(&s, 0).unwrap(),
+        LineContact::full_edge(&s, 1).unwrap(),
+    ];
     assert!(!theorem7(&cs, 0.5));
     let mut dirs = stable(&s, &cs[0], 0.5).unwrap().extremal;
     dirs.extend(stable(&s, &cs[1], 0.5).unwrap().extremal);
     assert!(!small_time_locally_controllable(&dirs));
     // All four edges: STLC.
-    let all: Vec<LineContact> = (0..4).map(|e| LineContact::full_edge(&s, e).unwrap()).collect();
+    let all: Vec<LineContact> = (0..4)
+        .map(|e| LineContact::full_edge(&s, e).unwrap())
+        .collect();
     assert!(theorem7(&all, 0.5));
 }
 
@@ -239,13 +309,28 @@ fn adjacent_edges_are_not_stlc() {
 /// centre of friction.
 #[test]
 fn theorem3_frictionless_centred_disk_is_the_only_exception() {
-    let disk = PushBoundary::Disk { centre: V2::zeros(), radius: 1.0 };
+    let disk = PushBoundary::Disk {
+        centre: V2::zeros(),
+        radius: 1.0,
+    };
     assert!(!theorem3(&disk, 0.0));
     assert!(theorem3(&disk, 0.2));
-    assert!(theorem3(&PushBoundary::Disk { centre: V2::new(0.3, 0.0), radius: 1.0 }, 0.0));
+    assert!(theorem3(
+        &PushBoundary::Disk {
+            centre: V2::new(0.3, 0.0),
+            radius: 1.0
+        },
+        0.0
+    ));
     assert!(theorem3(&PushBoundary::Polygon(square().vertices), 0.0));
-    assert!(theorem3(&PushBoundary::Polygon(regular(6, 1.0).vertices), 0.0));
-    assert!(theorem3(&PushBoundary::Polygon(rect(3.0, 1.0, V2::new(0.4, 0.2)).vertices.clone()), 0.5));
+    assert!(theorem3(
+        &PushBoundary::Polygon(regular(6, 1.0).vertices),
+        0.0
+    ));
+    assert!(theorem3(
+        &PushBoundary::Polygon(rect(3.0, 1.0, V2::new(0.4, 0.2)).vertices.clone()),
+        0.5
+    ));
 }
 
 /// Theorem 2 (through Proposition 5): any edge, frictionless or not; any vertex with friction
@@ -262,8 +347,13 @@ fn theorem2_and_theorem6_on_polygons() {
         assert!(!theorem6(&s, 0.0).unwrap(), "no interior without friction");
     }
     // Proposition 5's "only if": a single force direction, or forces all through the centre.
-    assert!(!pushbot::mechanics::controllability::proposition5(&[V3::new(0.0, 1.0, 0.5)]));
-    assert!(!pushbot::mechanics::controllability::proposition5(&[V3::new(0.0, 1.0, 0.0), V3::new(1.0, 0.0, 0.0)]));
+    assert!(!pushbot::mechanics::controllability::proposition5(&[
+        V3::new(0.0, 1.0, 0.5)
+    ]));
+    assert!(!pushbot::mechanics::controllability::proposition5(&[
+        V3::new(0.0, 1.0, 0.0),
+        V3::new(1.0, 0.0, 0.0)
+    ]));
 }
 
 /// Positive spanning on a known set: the six ± axes span, five do not.

@@ -58,7 +58,9 @@ pub struct BenchStableArgs {
 
 fn fmt_dir(v: &crate::mechanics::V3) -> serde_json::Value {
     match cor(v) {
-        Some(c) => json!({"twist": [v.x, v.y, v.z], "cor": [c.x, c.y], "sense": if v.z > 0.0 {"ccw"} else {"cw"}}),
+        Some(c) => {
+            json!({"twist": [v.x, v.y, v.z], "cor": [c.x, c.y], "sense": if v.z > 0.0 {"ccw"} else {"cw"}})
+        }
         None => json!({"twist": [v.x, v.y, v.z], "translation": [v.x, v.y]}),
     }
 }
@@ -66,7 +68,10 @@ fn fmt_dir(v: &crate::mechanics::V3) -> serde_json::Value {
 /// Run `pushbot mechanics`.
 pub fn run_mechanics(g: &Global, a: &MechanicsArgs) -> CliResult {
     let scene = load_scene(&a.scene).map_err(CliError::BadInput)?;
-    let id = a.object.clone().unwrap_or_else(|| scene.task.object.clone());
+    let id = a
+        .object
+        .clone()
+        .unwrap_or_else(|| scene.task.object.clone());
     let slider = scene.slider(&id).map_err(CliError::BadInput)?;
     let mu = scene.mu;
     let sets = stable_all_edges(&slider, mu).map_err(CliError::bad_input)?;
@@ -84,10 +89,20 @@ pub fn run_mechanics(g: &Global, a: &MechanicsArgs) -> CliResult {
             "point_contact_controllable_theorem2": controllability::theorem2_edge(&slider, e, mu).unwrap_or(false),
         }));
     }
-    let task_edges: Vec<usize> = if id == scene.task.object { scene.task.edges.clone() } else { vec![] };
-    let task_contacts: Vec<LineContact> =
-        task_edges.iter().filter_map(|&e| LineContact::full_edge(&slider, e).ok()).collect();
-    let union: Vec<_> = sets.iter().filter(|s| task_edges.contains(&s.contact.edge)).flat_map(|s| s.extremal.clone()).collect();
+    let task_edges: Vec<usize> = if id == scene.task.object {
+        scene.task.edges.clone()
+    } else {
+        vec![]
+    };
+    let task_contacts: Vec<LineContact> = task_edges
+        .iter()
+        .filter_map(|&e| LineContact::full_edge(&slider, e).ok())
+        .collect();
+    let union: Vec<_> = sets
+        .iter()
+        .filter(|s| task_edges.contains(&s.contact.edge))
+        .flat_map(|s| s.extremal.clone())
+        .collect();
     let all: Vec<LineContact> = sets.iter().map(|s| s.contact).collect();
     let out = json!({
         "object": id,
@@ -132,14 +147,20 @@ fn parse_c(c: &Option<String>) -> Result<Option<Option<u32>>, CliError> {
     match c.as_deref() {
         None => Ok(None),
         Some("inf") => Ok(Some(None)),
-        Some(v) => v.parse::<u32>().map(|x| Some(Some(x))).map_err(|_| CliError::bad_input(format!("--c: expected an integer or inf, got {v:?}"))),
+        Some(v) => v.parse::<u32>().map(|x| Some(Some(x))).map_err(|_| {
+            CliError::bad_input(format!("--c: expected an integer or inf, got {v:?}"))
+        }),
     }
 }
 
 /// Run `pushbot plan stable`.
 pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
     let scene = load_scene(&a.scene).map_err(CliError::BadInput)?;
-    let costs = CostOverride { a: a.a, b: a.b, c: parse_c(&a.c)? };
+    let costs = CostOverride {
+        a: a.a,
+        b: a.b,
+        c: parse_c(&a.c)?,
+    };
     let problem = scene.problem(costs).map_err(CliError::BadInput)?;
     let mut p = plan(&problem);
     if a.exact_goal && p.found {
@@ -149,14 +170,18 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
                 e.plan_time_ms = t;
                 p = e;
             }
-            None => return Err(CliError::Failed(anyhow::anyhow!("no single stable push reaches the goal exactly"))),
+            None => {
+                return Err(CliError::Failed(anyhow::anyhow!(
+                    "no single stable push reaches the goal exactly"
+                )));
+            }
         }
     }
     if let Some(path) = &a.svg {
         std::fs::write(path, svg::render(&problem, Some(&p)))
             .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display())))?;
     }
-    let transit_length: f64 = p.transits.iter().map(|t| t.length).sum();
+    let transit_length: f64 = p.transits.iter().map(|t| t.length).sum::<f64>() + 0.0;
     if g.json {
         let out = json!({
             "scene": scene.name,
@@ -182,12 +207,25 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
     } else if p.found {
         println!(
             "found: cost {}, {} pushes, {} control changes, {} contact changes, {} nodes, {:.1} ms, transit {:.3} m",
-            p.cost, p.pushes, p.control_changes, p.contact_changes, p.nodes_expanded, p.plan_time_ms, transit_length
+            p.cost,
+            p.pushes,
+            p.control_changes,
+            p.contact_changes,
+            p.nodes_expanded,
+            p.plan_time_ms,
+            transit_length
         );
     } else {
-        println!("no plan: {} nodes expanded in {:.1} ms", p.nodes_expanded, p.plan_time_ms);
+        println!(
+            "no plan: {} nodes expanded in {:.1} ms",
+            p.nodes_expanded, p.plan_time_ms
+        );
     }
-    Ok(if p.found { Status::Success } else { Status::TaskFailed })
+    Ok(if p.found {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
 }
 
 /// Run `pushbot bench stable`.
@@ -196,7 +234,9 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
     let mut all_found = true;
     for (name, paper) in PRESETS.iter().zip(PAPER_SECONDS) {
         let scene = load_scene(name).map_err(CliError::BadInput)?;
-        let problem = scene.problem(CostOverride::default()).map_err(CliError::BadInput)?;
+        let problem = scene
+            .problem(CostOverride::default())
+            .map_err(CliError::BadInput)?;
         let mut times = Vec::new();
         let mut last = None;
         for _ in 0..a.repeat.max(1) {
@@ -219,9 +259,15 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
         }));
     }
     if g.json {
-        println!("{}", json!({"bench": "stable", "repeat": a.repeat.max(1), "results": rows}));
+        println!(
+            "{}",
+            json!({"bench": "stable", "repeat": a.repeat.max(1), "results": rows})
+        );
     } else {
-        println!("{:<8} {:>6} {:>6} {:>8} {:>12} {:>8}", "preset", "found", "cost", "nodes", "time ms", "paper s");
+        println!(
+            "{:<8} {:>6} {:>6} {:>8} {:>12} {:>8}",
+            "preset", "found", "cost", "nodes", "time ms", "paper s"
+        );
         for r in &rows {
             println!(
                 "{:<8} {:>6} {:>6} {:>8} {:>12.2} {:>8}",
@@ -234,5 +280,9 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
             );
         }
     }
-    Ok(if all_found { Status::Success } else { Status::TaskFailed })
+    Ok(if all_found {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
 }

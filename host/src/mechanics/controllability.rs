@@ -15,7 +15,11 @@ const EPS: f64 = 1e-9;
 /// controllable in the obstacle-free plane, iff the set holds two directions that are not both
 /// translations and not opposite.
 pub fn controllable(dirs: &[V3]) -> bool {
-    let d: Vec<V3> = dirs.iter().filter(|v| v.norm() > EPS).map(|v| v.normalize()).collect();
+    let d: Vec<V3> = dirs
+        .iter()
+        .filter(|v| v.norm() > EPS)
+        .map(|v| v.normalize())
+        .collect();
     for i in 0..d.len() {
         for j in i + 1..d.len() {
             let distinct = (d[i] - d[j]).norm() > 1e-7;
@@ -31,7 +35,11 @@ pub fn controllable(dirs: &[V3]) -> bool {
 
 /// Whether the directions positively span R³ (`0` inside their convex hull; Theorem 1, part 1).
 pub fn positively_spans_space(dirs: &[V3]) -> bool {
-    let d: Vec<V3> = dirs.iter().filter(|v| v.norm() > EPS).map(|v| v.normalize()).collect();
+    let d: Vec<V3> = dirs
+        .iter()
+        .filter(|v| v.norm() > EPS)
+        .map(|v| v.normalize())
+        .collect();
     let mut full_rank = false;
     for i in 0..d.len() {
         for j in i + 1..d.len() {
@@ -62,7 +70,11 @@ fn angles_span_circle(mut a: Vec<f64>) -> bool {
     a.sort_by(f64::total_cmp);
     let mut max_gap: f64 = 0.0;
     for i in 0..a.len() {
-        let next = if i + 1 < a.len() { a[i + 1] } else { a[0] + 2.0 * PI };
+        let next = if i + 1 < a.len() {
+            a[i + 1]
+        } else {
+            a[0] + 2.0 * PI
+        };
         max_gap = max_gap.max(next - a[i]);
     }
     max_gap < PI - 1e-9
@@ -75,7 +87,11 @@ pub fn small_time_locally_controllable(dirs: &[V3]) -> bool {
     if positively_spans_space(dirs) {
         return true;
     }
-    let d: Vec<V3> = dirs.iter().filter(|v| v.norm() > EPS).map(|v| v.normalize()).collect();
+    let d: Vec<V3> = dirs
+        .iter()
+        .filter(|v| v.norm() > EPS)
+        .map(|v| v.normalize())
+        .collect();
     for i in 0..d.len() {
         for j in i + 1..d.len() {
             let n = d[i].cross(&d[j]);
@@ -88,8 +104,11 @@ pub fn small_time_locally_controllable(dirs: &[V3]) -> bool {
             }
             let b1 = d[i];
             let b2 = n.cross(&b1);
-            let angles: Vec<f64> =
-                d.iter().filter(|v| n.dot(v).abs() < 1e-9).map(|v| v.dot(&b2).atan2(v.dot(&b1))).collect();
+            let angles: Vec<f64> = d
+                .iter()
+                .filter(|v| n.dot(v).abs() < 1e-9)
+                .map(|v| v.dot(&b2).atan2(v.dot(&b1)))
+                .collect();
             if angles_span_circle(angles) {
                 return true;
             }
@@ -183,7 +202,9 @@ pub fn theorem2_edge(slider: &Slider, edge: usize, mu: f64) -> Result<bool, Mech
     let (a, b) = slider.edge(edge)?;
     let t = (b - a).normalize();
     let n = V2::new(-t.y, t.x);
-    let f: Vec<V3> = (1..8).flat_map(|k| point_forces(a + (b - a) * (k as f64 / 8.0), n, mu)).collect();
+    let f: Vec<V3> = (1..8)
+        .flat_map(|k| point_forces(a + (b - a) * (k as f64 / 8.0), n, mu))
+        .collect();
     Ok(proposition5(&f))
 }
 
@@ -194,7 +215,11 @@ pub fn theorem2_vertex(slider: &Slider, i: usize, mu: f64) -> Result<bool, Mecha
     if i >= n {
         return Err(MechanicsError::NoSuchEdge(i, n));
     }
-    let (prev, v, next) = (slider.vertices[(i + n - 1) % n], slider.vertices[i], slider.vertices[(i + 1) % n]);
+    let (prev, v, next) = (
+        slider.vertices[(i + n - 1) % n],
+        slider.vertices[i],
+        slider.vertices[(i + 1) % n],
+    );
     let t1 = (v - prev).normalize();
     let t2 = (next - v).normalize();
     let (n1, n2) = (V2::new(-t1.y, t1.x), V2::new(-t2.y, t2.x));
@@ -216,7 +241,10 @@ pub fn theorem3(g: &PushBoundary, mu: f64) -> bool {
         PushBoundary::Disk { centre, radius } => (centre.norm() + radius) * 0.6,
     };
     let ls = EllipsoidLimitSurface { c: c.max(1e-6) };
-    let v: Vec<V3> = boundary_forces(g, mu, 6).iter().map(|f| ls.velocity(f)).collect();
+    let v: Vec<V3> = boundary_forces(g, mu, 6)
+        .iter()
+        .map(|f| ls.velocity(f))
+        .collect();
     small_time_locally_controllable(&v)
 }
 
@@ -262,7 +290,10 @@ pub fn theorem6(slider: &Slider, mu: f64) -> Result<bool, MechanicsError> {
 /// Theorem 7: the pure forces interior to at least one contact's composite friction cone
 /// positively span the plane of pure forces ⇒ small-time locally controllable by STABLE pushes.
 pub fn theorem7(contacts: &[LineContact], mu: f64) -> bool {
-    let arcs: Vec<(f64, f64)> = contacts.iter().filter_map(|c| pure_force_arc(c, mu)).collect();
+    let arcs: Vec<(f64, f64)> = contacts
+        .iter()
+        .filter_map(|c| pure_force_arc(c, mu))
+        .collect();
     if arcs.is_empty() {
         return false;
     }
@@ -286,16 +317,29 @@ mod tests {
     fn two_translations_are_not_controllable() {
         assert!(!controllable(&[V3::x(), V3::y()]));
         assert!(controllable(&[V3::x(), V3::new(0.0, 1.0, 1.0)]));
-        assert!(!controllable(&[V3::new(0.0, 1.0, 1.0), V3::new(0.0, -1.0, -1.0)]));
+        assert!(!controllable(&[
+            V3::new(0.0, 1.0, 1.0),
+            V3::new(0.0, -1.0, -1.0)
+        ]));
     }
 
     #[test]
     fn one_open_hemisphere_is_not_stlc() {
         // Theorem 1, part 2: all in the open half-space v_y > 0.
-        let d = [V3::new(0.0, 1.0, 1.0), V3::new(0.0, 1.0, -1.0), V3::new(1.0, 1.0, 0.0), V3::new(-1.0, 1.0, 0.0)];
+        let d = [
+            V3::new(0.0, 1.0, 1.0),
+            V3::new(0.0, 1.0, -1.0),
+            V3::new(1.0, 1.0, 0.0),
+            V3::new(-1.0, 1.0, 0.0),
+        ];
         assert!(!small_time_locally_controllable(&d));
         // Reversible pair of rotations: a great circle not at ω = 0 (Proposition 4).
-        let d = [V3::new(1.0, 0.0, 1.0), V3::new(-1.0, 0.0, -1.0), V3::new(0.0, 1.0, 0.0), V3::new(0.0, -1.0, 0.0)];
+        let d = [
+            V3::new(1.0, 0.0, 1.0),
+            V3::new(-1.0, 0.0, -1.0),
+            V3::new(0.0, 1.0, 0.0),
+            V3::new(0.0, -1.0, 0.0),
+        ];
         assert!(small_time_locally_controllable(&d));
         // Four translations only: the ω = 0 circle, not STLC.
         let d = [V3::x(), -V3::x(), V3::y(), -V3::y()];

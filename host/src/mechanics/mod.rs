@@ -117,7 +117,10 @@ impl Slider {
     pub fn is_hull_edge(&self, i: usize) -> Result<bool, MechanicsError> {
         let (a, b) = self.edge(i)?;
         let len = (b - a).norm();
-        Ok(self.vertices.iter().all(|&v| cross(b - a, v - a) >= -1e-9 * len))
+        Ok(self
+            .vertices
+            .iter()
+            .all(|&v| cross(b - a, v - a) >= -1e-9 * len))
     }
 }
 
@@ -223,10 +226,15 @@ pub fn convex_hull(points: &[V2]) -> Vec<V2> {
     let mut h: Vec<V2> = Vec::with_capacity(2 * p.len());
     for pass in 0..2 {
         let start = h.len();
-        let iter: Box<dyn Iterator<Item = &V2>> =
-            if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
+        let iter: Box<dyn Iterator<Item = &V2>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
         for &q in iter {
-            while h.len() >= start + 2 && cross(h[h.len() - 1] - h[h.len() - 2], q - h[h.len() - 2]) <= 0.0 {
+            while h.len() >= start + 2
+                && cross(h[h.len() - 1] - h[h.len() - 2], q - h[h.len() - 2]) <= 0.0
+            {
                 h.pop();
             }
             h.push(q);

@@ -55,14 +55,27 @@ impl StableSet {
     /// The set intersected with further constraints (rows `a·v ≥ 0`, slider frame).
     pub fn intersect(&self, extra: &[V3]) -> StableSet {
         let mut constraints = self.constraints.clone();
-        constraints.extend(extra.iter().filter(|a| a.norm() > 0.0).map(|a| a.normalize()));
+        constraints.extend(
+            extra
+                .iter()
+                .filter(|a| a.norm() > 0.0)
+                .map(|a| a.normalize()),
+        );
         let extremal = extreme_rays(&constraints);
-        StableSet { contact: self.contact, constraints, extremal }
+        StableSet {
+            contact: self.contact,
+            constraints,
+            extremal,
+        }
     }
 
     /// Translation directions among the extremal set.
     pub fn translations(&self) -> Vec<V3> {
-        self.extremal.iter().copied().filter(|v| v.z.abs() < 1e-9).collect()
+        self.extremal
+            .iter()
+            .copied()
+            .filter(|v| v.z.abs() < 1e-9)
+            .collect()
     }
 
     /// Rotation centres of the extremal directions (`None` for translations).
@@ -72,12 +85,23 @@ impl StableSet {
 }
 
 /// The procedure STABLE for a line contact with pusher–slider friction coefficient `mu`.
-pub fn stable(slider: &Slider, contact: &LineContact, mu: f64) -> Result<StableSet, MechanicsError> {
+pub fn stable(
+    slider: &Slider,
+    contact: &LineContact,
+    mu: f64,
+) -> Result<StableSet, MechanicsError> {
     if !mu.is_finite() || mu < 0.0 {
         return Err(MechanicsError::BadFriction(mu));
     }
-    let verts: Vec<V2> = slider.vertices.iter().map(|&p| contact.to_contact_frame(p)).collect();
-    let (mut p1, mut p2) = (contact.to_contact_frame(contact.a), contact.to_contact_frame(contact.b));
+    let verts: Vec<V2> = slider
+        .vertices
+        .iter()
+        .map(|&p| contact.to_contact_frame(p))
+        .collect();
+    let (mut p1, mut p2) = (
+        contact.to_contact_frame(contact.a),
+        contact.to_contact_frame(contact.b),
+    );
     if p1.x > p2.x {
         std::mem::swap(&mut p1, &mut p2);
     }
@@ -86,37 +110,49 @@ pub fn stable(slider: &Slider, contact: &LineContact, mu: f64) -> Result<StableS
     let (s, c) = alpha.sin_cos();
     let band = |u: V2| {
         let d: Vec<f64> = verts.iter().map(|x| u.dot(x)).collect();
-        (d.iter().copied().fold(f64::INFINITY, f64::min), d.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+        (
+            d.iter().copied().fold(f64::INFINITY, f64::min),
+            d.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        )
     };
     let (e_l, e_r) = (V2::new(-s, c), V2::new(s, c));
     let (m_l, big_m_l) = band(e_l);
     let (m_r, big_m_r) = band(e_r);
     // h_u(v) = u_y v_x − u_x v_y as a row.
     let h = |u: V2| V3::new(u.y, -u.x, 0.0);
-    let mut rows: Vec<V3> = Vec::new();
-    // Step 1: friction-cone bands.
-    rows.push(h(e_l) + V3::new(0.0, 0.0, -big_m_l));
-    rows.push(h(e_l) + V3::new(0.0, 0.0, -m_l));
-    rows.push(-h(e_r) + V3::new(0.0, 0.0, m_r));
-    rows.push(-h(e_r) + V3::new(0.0, 0.0, big_m_r));
-    // Step 2: end-point bands (bisector and tip line r²/p).
     let (n1, n2) = (p1.norm(), p2.norm());
     if n1 < 1e-12 || n2 < 1e-12 {
         return Err(MechanicsError::CofOutside);
     }
     let (u1, u2) = (p1 / n1, p2 / n2);
-    rows.push(h(u1) + V3::new(0.0, 0.0, -n1 / 2.0));
-    rows.push(h(u1) + V3::new(0.0, 0.0, r2 / n1));
-    rows.push(-h(u2) + V3::new(0.0, 0.0, -r2 / n2));
-    rows.push(-h(u2) + V3::new(0.0, 0.0, n2 / 2.0));
     // Theorem 4's lines.
     let xmin = verts.iter().map(|v| v.x).fold(f64::INFINITY, f64::min);
     let xmax = verts.iter().map(|v| v.x).fold(f64::NEG_INFINITY, f64::max);
-    rows.push(V3::new(0.0, 1.0, xmin));
-    rows.push(V3::new(0.0, 1.0, xmax));
-    let constraints: Vec<V3> = rows.iter().map(|r| contact.twist_to_slider(*r).normalize()).collect();
+    let rows = [
+        // Step 1: friction-cone bands.
+        h(e_l) + V3::new(0.0, 0.0, -big_m_l),
+        h(e_l) + V3::new(0.0, 0.0, -m_l),
+        -h(e_r) + V3::new(0.0, 0.0, m_r),
+        -h(e_r) + V3::new(0.0, 0.0, big_m_r),
+        // Step 2: end-point bands (bisector and tip line r²/p).
+        h(u1) + V3::new(0.0, 0.0, -n1 / 2.0),
+        h(u1) + V3::new(0.0, 0.0, r2 / n1),
+        -h(u2) + V3::new(0.0, 0.0, -r2 / n2),
+        -h(u2) + V3::new(0.0, 0.0, n2 / 2.0),
+        // Theorem 4.
+        V3::new(0.0, 1.0, xmin),
+        V3::new(0.0, 1.0, xmax),
+    ];
+    let constraints: Vec<V3> = rows
+        .iter()
+        .map(|r| contact.twist_to_slider(*r).normalize())
+        .collect();
     let extremal = extreme_rays(&constraints);
-    Ok(StableSet { contact: *contact, constraints, extremal })
+    Ok(StableSet {
+        contact: *contact,
+        constraints,
+        extremal,
+    })
 }
 
 /// STABLE for every hull edge of the slider, each pushed along its whole length.
@@ -142,7 +178,9 @@ pub fn extreme_rays(rows: &[V3]) -> Vec<V3> {
             }
             for sgn in [1.0, -1.0] {
                 let r = d.normalize() * sgn;
-                if rows.iter().all(|a| a.dot(&r) >= -TOL) && !rays.iter().any(|q| (q - r).norm() < 1e-7) {
+                if rows.iter().all(|a| a.dot(&r) >= -TOL)
+                    && !rays.iter().any(|q| (q - r).norm() < 1e-7)
+                {
                     rays.push(r);
                 }
             }
@@ -171,7 +209,12 @@ mod tests {
     use super::*;
 
     fn square() -> Slider {
-        let o = [V2::new(-1.0, -1.0), V2::new(1.0, -1.0), V2::new(1.0, 1.0), V2::new(-1.0, 1.0)];
+        let o = [
+            V2::new(-1.0, -1.0),
+            V2::new(1.0, -1.0),
+            V2::new(1.0, 1.0),
+            V2::new(-1.0, 1.0),
+        ];
         Slider::new(&o, V2::zeros()).unwrap()
     }
 

@@ -31,13 +31,18 @@ pub struct Obstacle {
 
 impl std::fmt::Debug for Obstacle {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Obstacle").field("vertices", &self.vertices).finish()
+        f.debug_struct("Obstacle")
+            .field("vertices", &self.vertices)
+            .finish()
     }
 }
 
 /// Convert a point list to a parry convex polygon (the convex hull of the points).
 pub fn convex(points: &[V2]) -> Option<ConvexPolygon> {
-    let pts: Vec<PVec> = points.iter().map(|p| PVec::new(p.x as f32, p.y as f32)).collect();
+    let pts: Vec<PVec> = points
+        .iter()
+        .map(|p| PVec::new(p.x as f32, p.y as f32))
+        .collect();
     ConvexPolygon::from_convex_hull(&pts)
 }
 
@@ -54,7 +59,11 @@ impl Obstacle {
             xs.fold(f64::NEG_INFINITY, f64::max),
             ys.fold(f64::NEG_INFINITY, f64::max),
         ];
-        Some(Obstacle { shape, bounds, vertices })
+        Some(Obstacle {
+            shape,
+            bounds,
+            vertices,
+        })
     }
 }
 
@@ -74,8 +83,13 @@ impl World {
     pub fn new(w: f64, h: f64, obstacles: Vec<Obstacle>) -> Self {
         let t = 1.0 + w.max(h);
         let rect = |x0: f64, y0: f64, x1: f64, y1: f64| {
-            Obstacle::new(&[V2::new(x0, y0), V2::new(x1, y0), V2::new(x1, y1), V2::new(x0, y1)])
-                .expect("wall rectangle is not degenerate")
+            Obstacle::new(&[
+                V2::new(x0, y0),
+                V2::new(x1, y0),
+                V2::new(x1, y1),
+                V2::new(x0, y1),
+            ])
+            .expect("wall rectangle is not degenerate")
         };
         let mut all = vec![
             rect(-t, -t, w + t, 0.0),
@@ -84,7 +98,11 @@ impl World {
             rect(w, 0.0, w + t, h),
         ];
         all.extend(obstacles);
-        World { table: (w, h), obstacles: all, n_walls: 4 }
+        World {
+            table: (w, h),
+            obstacles: all,
+            n_walls: 4,
+        }
     }
 }
 
@@ -100,7 +118,9 @@ pub struct Body {
 
 impl std::fmt::Debug for Body {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Body").field("vertices", &self.vertices).finish()
+        f.debug_struct("Body")
+            .field("vertices", &self.vertices)
+            .finish()
     }
 }
 
@@ -116,7 +136,11 @@ impl Body {
             }
         }
         let radius = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        Body { parts: shapes, vertices, radius }
+        Body {
+            parts: shapes,
+            vertices,
+            radius,
+        }
     }
 
     /// Smallest distance from the body at `q` to any obstacle whose box is within `reach` of
@@ -162,7 +186,11 @@ impl Body {
     pub fn reach(&self, xi: &V3) -> f64 {
         match super::cor_of(xi) {
             Some(c) => {
-                let rho = self.vertices.iter().map(|v| (v - c).norm()).fold(0.0, f64::max);
+                let rho = self
+                    .vertices
+                    .iter()
+                    .map(|v| (v - c).norm())
+                    .fold(0.0, f64::max);
                 rho * xi.z.abs()
             }
             None => (xi.x * xi.x + xi.y * xi.y).sqrt(),
@@ -171,7 +199,13 @@ impl Body {
 
     /// As [`Body::step_free`], given (optionally) the clearance at `q` already measured with
     /// a broad phase of at least this step's reach.
-    pub fn step_free_from(&self, world: &World, q: &Pose, xi: &V3, start_clearance: Option<f64>) -> bool {
+    pub fn step_free_from(
+        &self,
+        world: &World,
+        q: &Pose,
+        xi: &V3,
+        start_clearance: Option<f64>,
+    ) -> bool {
         let reach = self.reach(xi);
         if reach <= 0.0 {
             return self.free_at(world, q);
@@ -181,12 +215,17 @@ impl Body {
         loop {
             let d = match first.take() {
                 Some(d) => d,
-                None => self.clearance(world, &q.integrate(&(xi * t)), reach * (1.0 - t) + CONTACT_EPS),
+                None => self.clearance(
+                    world,
+                    &q.integrate(&(xi * t)),
+                    reach * (1.0 - t) + CONTACT_EPS,
+                ),
             };
             if d <= CONTACT_EPS {
                 return false;
             }
-            if t >= 1.0 {
+            // Nothing can close the remaining gap before the step ends.
+            if t >= 1.0 || d - reach * (1.0 - t) > CONTACT_EPS {
                 return true;
             }
             // d is a lower bound only for obstacles inside the broad phase; those outside are

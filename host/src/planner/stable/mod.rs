@@ -191,18 +191,48 @@ impl Problem {
             let placement = pusher.placement(&slider, e)?;
             let st = stable(&slider, &placement.contact, mu)?;
             let usable = pusher.usable(&st, &placement);
-            let footprint: Vec<V2> = pusher.footprint.iter().map(|p| placement.to_slider(*p)).collect();
+            let footprint: Vec<V2> = pusher
+                .footprint
+                .iter()
+                .map(|p| placement.to_slider(*p))
+                .collect();
             let mut parts = vec![slider.vertices.clone()];
             if !footprint.is_empty() {
                 parts.push(footprint.clone());
             }
             let body = Body::new(&parts);
-            let steps = usable.controls.iter().map(|v| step_twist(&slider, v, params.step)).collect();
+            let steps = usable
+                .controls
+                .iter()
+                .map(|v| step_twist(&slider, v, params.step))
+                .collect();
             let fine = params.step / params.fine_factor.max(1.0);
-            let fine_steps = usable.controls.iter().map(|v| step_twist(&slider, v, fine)).collect();
-            contacts.push(ContactModel { edge: e, placement, usable, body, footprint, steps, fine_steps });
+            let fine_steps = usable
+                .controls
+                .iter()
+                .map(|v| step_twist(&slider, v, fine))
+                .collect();
+            contacts.push(ContactModel {
+                edge: e,
+                placement,
+                usable,
+                body,
+                footprint,
+                steps,
+                fine_steps,
+            });
         }
-        Ok(Problem { world, slider, mu, pusher, contacts, start, goal, params, start_contact: None })
+        Ok(Problem {
+            world,
+            slider,
+            mu,
+            pusher,
+            contacts,
+            start,
+            goal,
+            params,
+            start_contact: None,
+        })
     }
 
     /// Whether `q` is in the refined region around the goal (§4.5).
@@ -214,7 +244,11 @@ impl Problem {
     /// The step twists of contact `ci` at configuration `q`.
     pub fn steps_at(&self, ci: usize, q: &Pose) -> &[V3] {
         let cm = &self.contacts[ci];
-        if self.near_goal(q) { &cm.fine_steps } else { &cm.steps }
+        if self.near_goal(q) {
+            &cm.fine_steps
+        } else {
+            &cm.steps
+        }
     }
 
     /// Whether `q` is in the goal neighbourhood.
@@ -230,7 +264,11 @@ impl Problem {
 pub fn step_twist(slider: &Slider, v: &V3, step: f64) -> V3 {
     match cor_of(v) {
         Some(c) => {
-            let rho = slider.vertices.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
+            let rho = slider
+                .vertices
+                .iter()
+                .map(|p| (p - c).norm())
+                .fold(0.0, f64::max);
             v * (step / rho / v.z.abs())
         }
         None => v * (step / (v.x * v.x + v.y * v.y).sqrt()),
@@ -244,7 +282,11 @@ mod tests {
     #[test]
     fn integrate_and_twist_to_round_trip() {
         let q = Pose::new(1.0, 2.0, 0.3);
-        for xi in [V3::new(0.2, 0.5, 0.0), V3::new(0.1, 0.3, 0.4), V3::new(-0.3, 0.2, -1.2)] {
+        for xi in [
+            V3::new(0.2, 0.5, 0.0),
+            V3::new(0.1, 0.3, 0.4),
+            V3::new(-0.3, 0.2, -1.2),
+        ] {
             let r = q.integrate(&xi);
             let back = q.twist_to(&r);
             assert!((back - xi).norm() < 1e-9, "{back:?} vs {xi:?}");

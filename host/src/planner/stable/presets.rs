@@ -226,7 +226,11 @@ fn preset_text(name: &str) -> Option<String> {
             "[0, 3]",
             0.1,
             "kind = \"arm\"\n",
-            if name == "fig16" { (1, 5, "0") } else { (0, 1, "10") },
+            if name == "fig16" {
+                (1, 5, "0")
+            } else {
+                (0, 1, "10")
+            },
         ),
         "fig18" => (
             18,
@@ -283,7 +287,10 @@ pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
         return parse_scene(&t).with_context(|| format!("preset {name_or_path}"));
     }
     let text = std::fs::read_to_string(name_or_path).with_context(|| {
-        format!("scene {name_or_path:?} is neither a preset ({}) nor a readable file", PRESETS.join(", "))
+        format!(
+            "scene {name_or_path:?} is neither a preset ({}) nor a readable file",
+            PRESETS.join(", ")
+        )
     })?;
     parse_scene(&text).with_context(|| format!("scene file {name_or_path}"))
 }
@@ -350,8 +357,8 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
     {
         bail!("planner.fine_radius_frac: must be finite and >= 0, got {v}");
     }
-    if p.max_cost.is_some_and(|m| m > 10_000_000) {
-        bail!("planner.max_cost: at most 10000000");
+    if p.max_cost.is_some_and(|m| m > 1_000_000) {
+        bail!("planner.max_cost: at most 1000000");
     }
     match s.pusher.kind.as_str() {
         "arm" | "omni" | "car" | "diff-drive" => {}
@@ -394,9 +401,16 @@ pub struct CostOverride {
 impl Scene {
     /// The slider of object `id` (slider frame at its centre of friction).
     pub fn slider(&self, id: &str) -> anyhow::Result<Slider> {
-        let o = self.objects.iter().find(|o| o.id == id).ok_or_else(|| anyhow!("no object with id {id:?}"))?;
+        let o = self
+            .objects
+            .iter()
+            .find(|o| o.id == id)
+            .ok_or_else(|| anyhow!("no object with id {id:?}"))?;
         let outline = pts(&o.polygon);
-        let cof = o.centre_of_friction.map(|c| V2::new(c[0], c[1])).unwrap_or_else(|| centroid(&outline));
+        let cof = o
+            .centre_of_friction
+            .map(|c| V2::new(c[0], c[1]))
+            .unwrap_or_else(|| centroid(&outline));
         Slider::new(&outline, cof).map_err(|e| anyhow!("objects[{id}]: {e}"))
     }
 
@@ -410,7 +424,9 @@ impl Scene {
         match p.kind.as_str() {
             "omni" => Pusher::boxed(PusherKind::Omni, w, d, d / 2.0, plate),
             "car" => Pusher::boxed(
-                PusherKind::Car { min_turning_radius: p.min_turning_radius.unwrap_or(0.0) },
+                PusherKind::Car {
+                    min_turning_radius: p.min_turning_radius.unwrap_or(0.0),
+                },
                 w,
                 d,
                 axle,
@@ -429,7 +445,12 @@ impl Scene {
         let step = pl.step_frac.unwrap_or(0.2) * len;
         let c = match costs.c {
             Some(c) => c,
-            None => pl.c.as_ref().map(|c| c.value()).transpose()?.unwrap_or(Some(0)),
+            None => {
+                pl.c.as_ref()
+                    .map(|c| c.value())
+                    .transpose()?
+                    .unwrap_or(Some(0))
+            }
         };
         let params = Params {
             a: costs.a.or(pl.a).unwrap_or(1),
@@ -447,7 +468,9 @@ impl Scene {
         };
         let mut obstacles = Vec::new();
         for o in &self.obstacles {
-            obstacles.push(Obstacle::new(&pts(&o.polygon)).ok_or_else(|| anyhow!("degenerate obstacle"))?);
+            obstacles.push(
+                Obstacle::new(&pts(&o.polygon)).ok_or_else(|| anyhow!("degenerate obstacle"))?,
+            );
         }
         for o in &self.objects {
             if o.id == self.task.object {
@@ -457,23 +480,45 @@ impl Scene {
                 let s = self.slider(&o.id)?;
                 let q = Pose::new(pose[0], pose[1], pose[2].to_radians());
                 let w: Vec<V2> = s.vertices.iter().map(|v| q.apply(*v)).collect();
-                obstacles.push(Obstacle::new(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?);
+                obstacles.push(
+                    Obstacle::new(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?,
+                );
             }
         }
         let world = World::new(self.table[0], self.table[1], obstacles);
         let t = &self.task;
         let start = Pose::new(t.start[0], t.start[1], t.start[2].to_radians());
         let goal = Pose::new(t.goal[0], t.goal[1], t.goal[2].to_radians());
-        let mut problem = Problem::new(world, slider, self.mu, self.pusher(), &t.edges, start, goal, params)
-            .map_err(|e| anyhow!("task.edges: {e}"))?;
-        problem.start_contact = t.start_edge.and_then(|e| t.edges.iter().position(|&x| x == e));
+        let mut problem = Problem::new(
+            world,
+            slider,
+            self.mu,
+            self.pusher(),
+            &t.edges,
+            start,
+            goal,
+            params,
+        )
+        .map_err(|e| anyhow!("task.edges: {e}"))?;
+        problem.start_contact = t
+            .start_edge
+            .and_then(|e| t.edges.iter().position(|&x| x == e));
         for (i, cm) in problem.contacts.iter().enumerate() {
             if cm.usable.controls.is_empty() {
-                bail!("task.edges[{i}]: edge {} has no usable stable push for this pusher", cm.edge);
+                bail!(
+                    "task.edges[{i}]: edge {} has no usable stable push for this pusher",
+                    cm.edge
+                );
             }
         }
-        if !problem.contacts.iter().any(|cm| cm.body.free_at(&problem.world, &start)) {
-            bail!("task.start: the slider and pusher collide with an obstacle or wall at the start");
+        if !problem
+            .contacts
+            .iter()
+            .any(|cm| cm.body.free_at(&problem.world, &start))
+        {
+            bail!(
+                "task.start: the slider and pusher collide with an obstacle or wall at the start"
+            );
         }
         Ok(problem)
     }

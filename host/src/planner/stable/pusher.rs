@@ -48,14 +48,35 @@ pub struct Pusher {
 impl Pusher {
     /// A pusher of negligible extent, as the robot arm of §4.4.
     pub fn arm() -> Self {
-        Pusher { kind: PusherKind::Arm, footprint: vec![], plate_width: None, axle_offset: 0.0 }
+        Pusher {
+            kind: PusherKind::Arm,
+            footprint: vec![],
+            plate_width: None,
+            axle_offset: 0.0,
+        }
     }
 
     /// A box-shaped mobile robot `width × depth` behind its front plate.
-    pub fn boxed(kind: PusherKind, width: f64, depth: f64, axle_offset: f64, plate_width: Option<f64>) -> Self {
+    pub fn boxed(
+        kind: PusherKind,
+        width: f64,
+        depth: f64,
+        axle_offset: f64,
+        plate_width: Option<f64>,
+    ) -> Self {
         let w = width / 2.0;
-        let footprint = vec![V2::new(-w, -depth), V2::new(w, -depth), V2::new(w, 0.0), V2::new(-w, 0.0)];
-        Pusher { kind, footprint, plate_width, axle_offset }
+        let footprint = vec![
+            V2::new(-w, -depth),
+            V2::new(w, -depth),
+            V2::new(w, 0.0),
+            V2::new(-w, 0.0),
+        ];
+        Pusher {
+            kind,
+            footprint,
+            plate_width,
+            axle_offset,
+        }
     }
 
     /// Whether contact changes need a transit path in the plane (§4.6): every mobile robot.
@@ -67,7 +88,10 @@ impl Pusher {
     /// (the robot's swept disk when turning in place).
     pub fn turning_radius_disk(&self) -> f64 {
         let c = V2::new(0.0, -self.axle_offset);
-        self.footprint.iter().map(|p| (p - c).norm()).fold(0.0, f64::max)
+        self.footprint
+            .iter()
+            .map(|p| (p - c).norm())
+            .fold(0.0, f64::max)
     }
 
     /// Where the pusher sits on edge `edge`: the contact-frame x of its centre line (the foot of
@@ -75,7 +99,10 @@ impl Pusher {
     /// contact its plate makes there.
     pub fn placement(&self, slider: &Slider, edge: usize) -> Result<Placement, MechanicsError> {
         let full = LineContact::full_edge(slider, edge)?;
-        let (xa, xb) = (full.to_contact_frame(full.a).x, full.to_contact_frame(full.b).x);
+        let (xa, xb) = (
+            full.to_contact_frame(full.a).x,
+            full.to_contact_frame(full.b).x,
+        );
         let y0 = full.to_contact_frame(full.a).y;
         let offset = 0.0f64.clamp(xa.min(xb), xa.max(xb));
         let (lo, hi) = match self.plate_width {
@@ -84,8 +111,19 @@ impl Pusher {
         };
         let t = full.tangent();
         let n = full.normal();
-        let contact = LineContact { edge, a: t * lo + n * y0, b: t * hi + n * y0 };
-        Ok(Placement { contact, offset, y0, origin: t * offset + n * y0, tangent: t, normal: n })
+        let contact = LineContact {
+            edge,
+            a: t * lo + n * y0,
+            b: t * hi + n * y0,
+        };
+        Ok(Placement {
+            contact,
+            offset,
+            y0,
+            origin: t * offset + n * y0,
+            tangent: t,
+            normal: n,
+        })
     }
 
     /// Extra constraints (rows `a·v ≥ 0`, contact frame) that the pusher's kinematics impose;
@@ -97,7 +135,9 @@ impl Pusher {
             PusherKind::Arm | PusherKind::Omni => vec![],
             // Rotation about (c_x, y_axle): v_x = ω y_axle. Forward: the robot's centre point
             // moves with v_y + ω x_r > 0; turning radius |c_x − x_r| ≥ R.
-            PusherKind::Car { min_turning_radius: r } => vec![
+            PusherKind::Car {
+                min_turning_radius: r,
+            } => vec![
                 V3::new(1.0, 0.0, -y_axle),
                 V3::new(-1.0, 0.0, y_axle),
                 V3::new(0.0, 1.0, x_r - r),
@@ -115,7 +155,11 @@ impl Pusher {
     /// pusher's feasible velocity directions. For a car or a differential drive the straight
     /// push is added to the controls when it is usable (as §4.4 advises, to smooth paths).
     pub fn usable(&self, stable: &StableSet, pl: &Placement) -> Usable {
-        let rows: Vec<V3> = self.kinematic_rows(pl).iter().map(|r| pl.contact.twist_to_slider(*r)).collect();
+        let rows: Vec<V3> = self
+            .kinematic_rows(pl)
+            .iter()
+            .map(|r| pl.contact.twist_to_slider(*r))
+            .collect();
         let set = stable.intersect(&rows);
         let mut controls = set.extremal.clone();
         if !rows.is_empty() {

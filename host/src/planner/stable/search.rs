@@ -12,6 +12,7 @@
 //! goal exactly.
 
 use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
 use super::collision;
@@ -20,6 +21,33 @@ use super::{Pose, Problem};
 use crate::mechanics::V3;
 
 const NONE: u32 = u32::MAX;
+
+/// A small multiplicative hasher for the pruning grid's integer keys (SipHash is the search's
+/// bottleneck otherwise).
+#[derive(Default)]
+struct GridHasher(u64);
+
+impl Hasher for GridHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(u64::from(*b));
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+}
+
+type GridSet = HashSet<(i64, i64, i64, u32), BuildHasherDefault<GridHasher>>;
 
 /// One push step of a plan.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -92,7 +120,11 @@ pub fn plan(p: &Problem) -> Plan {
 fn cell(p: &Problem, q: &Pose, contact: u32) -> (i64, i64, i64, u32) {
     let th = q.theta.rem_euclid(2.0 * std::f64::consts::PI);
     // Refined cells near the goal carry a tag so they never share a key with coarse cells.
-    let (f, tag) = if p.near_goal(q) { (p.params.fine_factor, 1i64 << 40) } else { (1.0, 0) };
+    let (f, tag) = if p.near_goal(q) {
+        (p.params.fine_factor, 1i64 << 40)
+    } else {
+        (1.0, 0)
+    };
     (
         (q.x * f / p.params.grid_xy).floor() as i64 + tag,
         (q.y * f / p.params.grid_xy).floor() as i64,
@@ -102,15 +134,22 @@ fn cell(p: &Problem, q: &Pose, contact: u32) -> (i64, i64, i64, u32) {
 }
 
 /// Cost of a step given the previous step's (contact, control).
-pub fn step_cost(p: &Problem, prev: Option<(usize, usize)>, contact: usize, control: usize) -> Option<u32> {
+pub fn step_cost(
+    p: &Problem,
+    prev: Option<(usize, usize)>,
+    contact: usize,
+    control: usize,
+) -> Option<u32> {
     let mut c = p.params.a;
+    // Saturating: costs come from the command line.
     if let Some((pc, pk)) = prev {
-        // `pk == usize::MAX`: the pusher waits at its start contact, no control yet.
-        if pk != usize::MAX && (pc, pk) != (contact, control) {
-            c += p.params.b;
+        // `pk == usize::MAX`: the pusher waits at its start contact, no control yet; leaving
+        // that contact is still a contact (and so a control) change.
+        if (pc, pk) != (contact, control) && (pk != usize::MAX || pc != contact) {
+            c = c.saturating_add(p.params.b);
         }
         if pc != contact {
-            c += p.params.c?;
+            c = c.saturating_add(p.params.c?);
         }
     }
     Some(c)
@@ -130,7 +169,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     }];
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
-    let mut occupied: HashSet<(i64, i64, i64, u32)> = HashSet::new();
+    let mut occupied: GridSet = GridSet::default();
     let max_cost = p.params.max_cost as usize;
     let mut buckets: Vec<std::collections::VecDeque<u32>> = vec![Default::default(); max_cost + 1];
     let mut heap: BinaryHeap<std::cmp::Reverse<(u32, u32)>> = BinaryHeap::new();
@@ -167,7 +206,14 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
             let key = (n.parent, n.contact);
             let t = *transit_cache.entry(key).or_insert_with(|| {
                 let par = &nodes[n.parent as usize];
-                transit(p, &par.q, par.contact as usize, n.contact as usize, nodes.len() as u32).map(|tp| {
+                transit(
+                    p,
+                    &par.q,
+                    par.contact as usize,
+                    n.contact as usize,
+                    nodes.len() as u32,
+                )
+                .map(|tp| {
                     transits.push(tp);
                     (transits.len() - 1) as u32
                 })
@@ -189,16 +235,26 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
             break;
         }
         expanded += 1;
-        let prev = (n.contact != NONE)
-            .then(|| (n.contact as usize, if n.control == NONE { usize::MAX } else { n.control as usize }));
+        let prev = (n.contact != NONE).then_some((
+            n.contact as usize,
+            if n.control == NONE {
+                usize::MAX
+            } else {
+                n.control as usize
+            },
+        ));
         for (ci, cm) in p.contacts.iter().enumerate() {
             // One clearance measurement at q serves every step of this contact.
             let steps = p.steps_at(ci, &n.q);
             let max_reach = steps.iter().map(|xi| cm.body.reach(xi)).fold(0.0, f64::max);
-            let d0 = cm.body.clearance(&p.world, &n.q, max_reach + collision::CONTACT_EPS);
+            let d0 = cm
+                .body
+                .clearance(&p.world, &n.q, max_reach + collision::CONTACT_EPS);
             for (k, xi) in steps.iter().enumerate() {
-                let Some(dc) = step_cost(p, prev, ci, k) else { continue };
-                let cost = n.cost + dc;
+                let Some(dc) = step_cost(p, prev, ci, k) else {
+                    continue;
+                };
+                let cost = n.cost.saturating_add(dc);
                 if cost > p.params.max_cost {
                     continue;
                 }
@@ -277,14 +333,14 @@ pub fn summarise(p: &Problem, plan: &mut Plan) {
     let mut prev: Option<(usize, usize)> = p.start_contact.map(|c| (c, usize::MAX));
     for s in &plan.steps {
         if let Some((pc, pk)) = prev {
-            if pk != usize::MAX && (pc, pk) != (s.contact, s.control) {
+            if (pc, pk) != (s.contact, s.control) && (pk != usize::MAX || pc != s.contact) {
                 plan.control_changes += 1;
             }
             if pc != s.contact {
                 plan.contact_changes += 1;
             }
         }
-        cost += step_cost(p, prev, s.contact, s.control).unwrap_or(0);
+        cost = cost.saturating_add(step_cost(p, prev, s.contact, s.control).unwrap_or(0));
         prev = Some((s.contact, s.control));
     }
     plan.cost = cost;
@@ -299,8 +355,16 @@ pub fn exact_goal(p: &Problem, plan: &Plan) -> Option<Plan> {
         return None;
     }
     for back in (0..=plan.steps.len()).rev() {
-        let q = if back == 0 { p.start } else { plan.steps[back - 1].to };
-        let last_contact = if back == 0 { p.start_contact } else { Some(plan.steps[back - 1].contact) };
+        let q = if back == 0 {
+            p.start
+        } else {
+            plan.steps[back - 1].to
+        };
+        let last_contact = if back == 0 {
+            p.start_contact
+        } else {
+            Some(plan.steps[back - 1].contact)
+        };
         let xi = q.twist_to(&p.goal);
         if xi.norm() < 1e-12 {
             continue;
@@ -344,7 +408,11 @@ pub fn exact_goal(p: &Problem, plan: &Plan) -> Option<Plan> {
                 let a = xi * (k as f64 / n_steps as f64);
                 let b = xi * ((k + 1) as f64 / n_steps as f64);
                 let from = q.integrate(&a);
-                let to = if k + 1 == n_steps { p.goal } else { q.integrate(&b) };
+                let to = if k + 1 == n_steps {
+                    p.goal
+                } else {
+                    q.integrate(&b)
+                };
                 let tw = xi / n_steps as f64;
                 out.steps.push(super::search::Step {
                     contact: ci,
@@ -369,7 +437,14 @@ pub fn exact_goal(p: &Problem, plan: &Plan) -> Option<Plan> {
 /// optimality claims (§4.3) on small instances.
 pub fn brute_force_cost(p: &Problem, depth: usize) -> Option<u32> {
     let mut best: Option<u32> = None;
-    fn rec(p: &Problem, q: Pose, prev: Option<(usize, usize)>, cost: u32, depth: usize, best: &mut Option<u32>) {
+    fn rec(
+        p: &Problem,
+        q: Pose,
+        prev: Option<(usize, usize)>,
+        cost: u32,
+        depth: usize,
+        best: &mut Option<u32>,
+    ) {
         if best.is_some_and(|b| cost >= b) {
             return;
         }
@@ -382,15 +457,33 @@ pub fn brute_force_cost(p: &Problem, depth: usize) -> Option<u32> {
         }
         for (ci, cm) in p.contacts.iter().enumerate() {
             for (k, xi) in p.steps_at(ci, &q).iter().enumerate() {
-                let Some(dc) = step_cost(p, prev, ci, k) else { continue };
-                if cost + dc > p.params.max_cost || !cm.body.step_free(&p.world, &q, xi) {
+                let Some(dc) = step_cost(p, prev, ci, k) else {
+                    continue;
+                };
+                if cost.saturating_add(dc) > p.params.max_cost
+                    || !cm.body.step_free(&p.world, &q, xi)
+                {
                     continue;
                 }
-                rec(p, q.integrate(xi), Some((ci, k)), cost + dc, depth - 1, best);
+                rec(
+                    p,
+                    q.integrate(xi),
+                    Some((ci, k)),
+                    cost + dc,
+                    depth - 1,
+                    best,
+                );
             }
         }
     }
-    rec(p, p.start, p.start_contact.map(|c| (c, usize::MAX)), 0, depth, &mut best);
+    rec(
+        p,
+        p.start,
+        p.start_contact.map(|c| (c, usize::MAX)),
+        0,
+        depth,
+        &mut best,
+    );
     best
 }
 

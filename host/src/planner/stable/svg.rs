@@ -8,7 +8,10 @@ use super::{Plan, Pose, Problem};
 use crate::mechanics::V2;
 
 fn poly(out: &mut String, pts: &[V2], h: f64, s: f64, style: &str) {
-    let p: Vec<String> = pts.iter().map(|v| format!("{:.2},{:.2}", v.x * s, (h - v.y) * s)).collect();
+    let p: Vec<String> = pts
+        .iter()
+        .map(|v| format!("{:.2},{:.2}", v.x * s, (h - v.y) * s))
+        .collect();
     let _ = writeln!(out, r#"<polygon points="{}" {style}/>"#, p.join(" "));
 }
 
@@ -25,19 +28,48 @@ pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
         w * s,
         h * s
     );
-    let _ = writeln!(out, r#"<rect x="0" y="0" width="{:.1}" height="{:.1}" fill="white" stroke="black" stroke-width="2"/>"#, w * s, h * s);
+    let _ = writeln!(
+        out,
+        r#"<rect x="0" y="0" width="{:.1}" height="{:.1}" fill="white" stroke="black" stroke-width="2"/>"#,
+        w * s,
+        h * s
+    );
     for o in &p.world.obstacles[p.world.n_walls..] {
-        poly(&mut out, &o.vertices, h, s, r##"fill="#888" stroke="black""##);
+        poly(
+            &mut out,
+            &o.vertices,
+            h,
+            s,
+            r##"fill="#888" stroke="black""##,
+        );
     }
     let at = |q: &Pose| -> Vec<V2> { p.slider.vertices.iter().map(|v| q.apply(*v)).collect() };
-    poly(&mut out, &at(&p.goal), h, s, r##"fill="none" stroke="#c00" stroke-dasharray="4 3" stroke-width="2""##);
-    poly(&mut out, &at(&p.start), h, s, r##"fill="#cde" stroke="black" stroke-width="1.5""##);
+    poly(
+        &mut out,
+        &at(&p.goal),
+        h,
+        s,
+        r##"fill="none" stroke="#c00" stroke-dasharray="4 3" stroke-width="2""##,
+    );
+    poly(
+        &mut out,
+        &at(&p.start),
+        h,
+        s,
+        r##"fill="#cde" stroke="black" stroke-width="1.5""##,
+    );
     if let Some(plan) = plan {
         let every = (plan.steps.len() / 40).max(1);
         let mut prev_contact = None;
         for (i, st) in plan.steps.iter().enumerate() {
             if i % every == 0 || i + 1 == plan.steps.len() {
-                poly(&mut out, &at(&st.to), h, s, r##"fill="none" stroke="#246" stroke-width="0.7""##);
+                poly(
+                    &mut out,
+                    &at(&st.to),
+                    h,
+                    s,
+                    r##"fill="none" stroke="#246" stroke-width="0.7""##,
+                );
             }
             if prev_contact != Some(st.contact) {
                 let fp = &p.contacts[st.contact].footprint;
@@ -53,7 +85,13 @@ pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
                 );
                 if !fp.is_empty() {
                     let w: Vec<V2> = fp.iter().map(|v| st.from.apply(*v)).collect();
-                    poly(&mut out, &w, h, s, r##"fill="#fc8" fill-opacity="0.6" stroke="#a50""##);
+                    poly(
+                        &mut out,
+                        &w,
+                        h,
+                        s,
+                        r##"fill="#fc8" fill-opacity="0.6" stroke="#a50""##,
+                    );
                 }
                 prev_contact = Some(st.contact);
             }
@@ -62,9 +100,17 @@ pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
             .chain(plan.steps.iter().map(|st| st.to))
             .map(|q| format!("{:.1},{:.1}", q.x * s, (h - q.y) * s))
             .collect();
-        let _ = writeln!(out, r##"<polyline points="{}" fill="none" stroke="#06c" stroke-width="1.5"/>"##, path.join(" "));
+        let _ = writeln!(
+            out,
+            r##"<polyline points="{}" fill="none" stroke="#06c" stroke-width="1.5"/>"##,
+            path.join(" ")
+        );
         for t in &plan.transits {
-            let pts: Vec<String> = t.waypoints.iter().map(|q| format!("{:.1},{:.1}", q[0] * s, (h - q[1]) * s)).collect();
+            let pts: Vec<String> = t
+                .waypoints
+                .iter()
+                .map(|q| format!("{:.1},{:.1}", q[0] * s, (h - q[1]) * s))
+                .collect();
             let _ = writeln!(
                 out,
                 r##"<polyline points="{}" fill="none" stroke="#a0a" stroke-dasharray="3 3" stroke-width="1.5"/>"##,

@@ -86,7 +86,13 @@ pub fn grow(poly: &[V2], r: f64) -> Vec<V2> {
 
 /// Shortest path for a disk of radius `r` from `s` to `g` among convex obstacles inside a
 /// `w × h` table (visibility graph + Dijkstra). Returns the way points.
-pub fn disk_path(s: V2, g: V2, r: f64, table: (f64, f64), obstacles: &[Vec<V2>]) -> Option<Vec<V2>> {
+pub fn disk_path(
+    s: V2,
+    g: V2,
+    r: f64,
+    table: (f64, f64),
+    obstacles: &[Vec<V2>],
+) -> Option<Vec<V2>> {
     let grown: Vec<Vec<V2>> = obstacles.iter().map(|o| grow(o, r)).collect();
     let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
     let free_pt = |p: V2| in_table(p) && !grown.iter().any(|o| inside_convex(p, o));
@@ -166,7 +172,7 @@ fn leg(p: &Problem, q: &Pose, contact: usize, r: f64) -> Option<(V2, V2)> {
         }
     }
     // The footprint alone translates by b along −n (slider frame), checked exactly.
-    let foot = Body::new(&[cm.footprint.clone()]);
+    let foot = Body::new(std::slice::from_ref(&cm.footprint));
     let xi = V3::new(back_dir.x * b, back_dir.y * b, 0.0);
     if !foot.step_free(&p.world, q, &xi) {
         return None;
@@ -177,21 +183,39 @@ fn leg(p: &Problem, q: &Pose, contact: usize, r: f64) -> Option<(V2, V2)> {
 /// Distance from point `p` to segment `a b`.
 pub fn point_segment_distance(p: V2, a: V2, b: V2) -> f64 {
     let d = b - a;
-    let t = if d.norm_squared() > 0.0 { ((p - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if d.norm_squared() > 0.0 {
+        ((p - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (a + d * t - p).norm()
 }
 
 /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`.
 pub fn transit(p: &Problem, q: &Pose, from: usize, to: usize, _tag: u32) -> Option<TransitPath> {
     if !p.pusher.is_mobile() || from == to {
-        return Some(TransitPath { from_contact: from, to_contact: to, at: *q, waypoints: vec![], length: 0.0 });
+        return Some(TransitPath {
+            from_contact: from,
+            to_contact: to,
+            at: *q,
+            waypoints: vec![],
+            length: 0.0,
+        });
     }
     let r = p.pusher.turning_radius_disk();
     let (c0, s0) = leg(p, q, from, r)?;
     let (c1, s1) = leg(p, q, to, r)?;
-    let mut obstacles: Vec<Vec<V2>> =
-        p.world.obstacles[p.world.n_walls..].iter().map(|o: &Obstacle| o.vertices.clone()).collect();
-    obstacles.push(convex_hull(&p.slider.vertices.iter().map(|v| q.apply(*v)).collect::<Vec<_>>()));
+    let mut obstacles: Vec<Vec<V2>> = p.world.obstacles[p.world.n_walls..]
+        .iter()
+        .map(|o: &Obstacle| o.vertices.clone())
+        .collect();
+    obstacles.push(convex_hull(
+        &p.slider
+            .vertices
+            .iter()
+            .map(|v| q.apply(*v))
+            .collect::<Vec<_>>(),
+    ));
     let mid = disk_path(s0, s1, r, p.world.table, &obstacles)?;
     let mut pts = vec![c0];
     pts.extend(mid);
@@ -212,23 +236,66 @@ mod tests {
 
     #[test]
     fn segment_through_square_hits_and_grazing_does_not() {
-        let sq = [V2::new(0.0, 0.0), V2::new(1.0, 0.0), V2::new(1.0, 1.0), V2::new(0.0, 1.0)];
-        assert!(segment_hits_convex(V2::new(-1.0, 0.5), V2::new(2.0, 0.5), &sq));
-        assert!(!segment_hits_convex(V2::new(-1.0, 1.0), V2::new(2.0, 1.0), &sq));
-        assert!(!segment_hits_convex(V2::new(-1.0, 2.0), V2::new(2.0, 1.5), &sq));
+        let sq = [
+            V2::new(0.0, 0.0),
+            V2::new(1.0, 0.0),
+            V2::new(1.0, 1.0),
+            V2::new(0.0, 1.0),
+        ];
+        assert!(segment_hits_convex(
+            V2::new(-1.0, 0.5),
+            V2::new(2.0, 0.5),
+            &sq
+        ));
+        assert!(!segment_hits_convex(
+            V2::new(-1.0, 1.0),
+            V2::new(2.0, 1.0),
+            &sq
+        ));
+        assert!(!segment_hits_convex(
+            V2::new(-1.0, 2.0),
+            V2::new(2.0, 1.5),
+            &sq
+        ));
     }
 
     #[test]
     fn disk_goes_around_a_wall() {
         // A wall across the middle with a gap at the top: the path must pass the gap.
-        let wall = vec![V2::new(4.5, 0.0), V2::new(5.5, 0.0), V2::new(5.5, 8.0), V2::new(4.5, 8.0)];
-        let path = disk_path(V2::new(1.0, 1.0), V2::new(9.0, 1.0), 0.5, (10.0, 10.0), &[wall]).unwrap();
+        let wall = vec![
+            V2::new(4.5, 0.0),
+            V2::new(5.5, 0.0),
+            V2::new(5.5, 8.0),
+            V2::new(4.5, 8.0),
+        ];
+        let path = disk_path(
+            V2::new(1.0, 1.0),
+            V2::new(9.0, 1.0),
+            0.5,
+            (10.0, 10.0),
+            &[wall],
+        )
+        .unwrap();
         let len: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-        // Lower bound: via the wall's grown top corners at y ≥ 8.5.
-        let lb = (V2::new(4.0, 8.5) - V2::new(1.0, 1.0)).norm() + 2.0 + (V2::new(9.0, 1.0) - V2::new(6.0, 8.5)).norm();
-        assert!(len >= lb - 1e-6 && len < lb + 0.5, "len {len} lb {lb}");
-        assert!(disk_path(V2::new(1.0, 1.0), V2::new(9.0, 1.0), 1.2, (10.0, 10.0), &[vec![
-            V2::new(4.5, 0.0), V2::new(5.5, 0.0), V2::new(5.5, 10.0), V2::new(4.5, 10.0)
-        ]]).is_none());
+        // Lower bound: the centre must cross x ∈ [4.5, 5.5] at y ≥ 8 (over the wall's top).
+        let lb = (V2::new(4.5, 8.0) - V2::new(1.0, 1.0)).norm()
+            + 1.0
+            + (V2::new(9.0, 1.0) - V2::new(5.5, 8.0)).norm();
+        assert!(len >= lb - 1e-6 && len < lb + 1.5, "len {len} lb {lb}");
+        assert!(
+            disk_path(
+                V2::new(1.0, 1.0),
+                V2::new(9.0, 1.0),
+                1.2,
+                (10.0, 10.0),
+                &[vec![
+                    V2::new(4.5, 0.0),
+                    V2::new(5.5, 0.0),
+                    V2::new(5.5, 10.0),
+                    V2::new(4.5, 10.0)
+                ]]
+            )
+            .is_none()
+        );
     }
 }
