@@ -551,7 +551,7 @@ fn decoder_survives_random_and_mutated_input() {
         d.feed::<HostFrame>(&input, |r| accepted += r.is_ok() as usize);
         d.feed::<RobotMsg>(&input, |_| {});
         inputs += 1;
-        if inputs % 1000 == 0 {
+        if inputs.is_multiple_of(1000) {
             // Resynchronise: a delimiter, then a good frame, must decode.
             let mut got = None;
             d.feed::<HostFrame>(&[0], |_| {});
