@@ -21,14 +21,3 @@
 //! * Time is robot time in microseconds, monotonic, handed in by the caller: the core never
 //!   reads a clock, so it runs identically on the board and at simulated time.
 #![cfg_attr(not(test), no_std)]
-#![forbid(unsafe_code)]
-#![warn(missing_docs)]
-
-mod fmt;
-
-mod robot;
-mod params;
-
-pub use robot::{Core, Inputs, Outputs};
-pub use params::{Limits, RobotParams};
-pub use pushbot_protocol::{Faults, FirmwareVersion, Geometry, Mode, Pose, WheelGains};
