@@ -1,2 +1,4 @@
 //! The simulated pushbot target.
 #![forbid(unsafe_code)]
+
+pub mod camera;

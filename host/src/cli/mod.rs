@@ -7,6 +7,8 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+pub mod vision;
+
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
 pub struct Global {
@@ -33,7 +35,15 @@ pub struct Cli {
 
 /// The commands.
 #[derive(Subcommand, Debug)]
-pub enum Command {}
+pub enum Command {
+    /// Calibrate the overhead camera from markers at known table positions.
+    Calibrate(vision::CalibrateArgs),
+    /// Track the robot, objects and goals with the overhead camera (one line per frame).
+    Track(vision::TrackArgs),
+    /// Measure speed.
+    #[command(subcommand)]
+    Bench(vision::BenchCommand),
+}
 
 /// How a command that ran to its end went.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,6 +112,9 @@ fn init_logging(verbose: u8) {
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
-    let _ = &global;
-    match command {}
+    match command {
+        Command::Calibrate(a) => vision::calibrate(&global, a),
+        Command::Track(a) => vision::track(&global, a),
+        Command::Bench(b) => vision::bench(&global, b),
+    }
 }
