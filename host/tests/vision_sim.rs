@@ -4,6 +4,7 @@
 use pushbot::vision::apriltag::{AprilTagC, AprilTagCConfig};
 use pushbot::vision::detect::Detector;
 use pushbot::vision::folder::FolderSource;
+#[cfg(feature = "kornia")]
 use pushbot::vision::kornia::{KorniaConfig, KorniaDetector};
 use pushbot::vision::layout::MarkerLayout;
 use pushbot::vision::simsocket::SimSocketSource;
@@ -52,6 +53,7 @@ fn accuracy_on_rendered_frames() {
 
 /// The kornia candidate reads the same frames with the same corner convention (a wrong corner
 /// order would show as a 90° heading error or a corner error of tens of pixels).
+#[cfg(feature = "kornia")]
 #[test]
 fn kornia_candidate_agrees_on_corners() {
     let layout = MarkerLayout::default_table();

@@ -35,6 +35,7 @@ pub struct CameraArgs {
 /// `pushbot calibrate`.
 #[derive(Args, Debug, Clone)]
 pub struct CalibrateArgs {
+    /// Source and layout.
     #[command(flatten)]
     pub camera: CameraArgs,
     /// Frames to collect detections from.
@@ -48,6 +49,7 @@ pub struct CalibrateArgs {
 /// `pushbot track`.
 #[derive(Args, Debug, Clone)]
 pub struct TrackArgs {
+    /// Source and layout.
     #[command(flatten)]
     pub camera: CameraArgs,
     /// A saved calibration; without one, the first frames showing four calibration markers

@@ -1,8 +1,8 @@
 //! `pushbot bench vision`: milliseconds per 960×720 frame for the chosen pipeline (C AprilTag
 //! detection + table poses + tracking) and, in the same run on the same rendered frames, for the
 //! reference C detector alone and for the pure-Rust `kornia-apriltag` candidate (at its defaults
-//! and with `threshold_split = 0.5`), each on one core; with detection rate, wrong ids and corner
-//! error against the renderer's ground truth.
+//! and with `threshold_split = 0.5`; built with `--features kornia`), each on one core; with
+//! detection rate, wrong ids and corner error against the renderer's ground truth.
 
 use std::time::Instant;
 
@@ -10,6 +10,7 @@ use serde::Serialize;
 
 use super::apriltag::{AprilTagC, AprilTagCConfig};
 use super::detect::{Detection, Detector};
+#[cfg(feature = "kornia")]
 use super::kornia::{KorniaConfig, KorniaDetector};
 use super::layout::MarkerLayout;
 use super::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
@@ -92,6 +93,7 @@ pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
     let mut c = AprilTagC::new(&families, &AprilTagCConfig::default()).map_err(|e| e.to_string())?;
     let (fig, c_dets) = time_detector(&mut c, "apriltag-c (reference, quad_decimate 2)".into(), &frames)?;
     detectors.push(fig);
+    #[cfg(feature = "kornia")]
     for (name, cfg) in [
         ("kornia-apriltag (defaults)", KorniaConfig::default()),
         ("kornia-apriltag (threshold_split 0.5)", KorniaConfig { threshold_split: Some(0.5), downscale: None }),

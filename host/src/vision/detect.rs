@@ -44,7 +44,7 @@ pub enum DetectError {
 pub enum DetectorKind {
     /// The reference C AprilTag library (bundled, pinned source): the default.
     ApriltagC,
-    /// The pure-Rust `kornia-apriltag`.
+    /// The pure-Rust `kornia-apriltag` (needs the `kornia` feature).
     Kornia,
 }
 
@@ -52,6 +52,11 @@ pub enum DetectorKind {
 pub fn make_detector(kind: DetectorKind, families: &[MarkerFamily]) -> Result<Box<dyn Detector>, DetectError> {
     Ok(match kind {
         DetectorKind::ApriltagC => Box::new(super::apriltag::AprilTagC::new(families, &Default::default())?),
+        #[cfg(feature = "kornia")]
         DetectorKind::Kornia => Box::new(super::kornia::KorniaDetector::new(families, &Default::default())?),
+        #[cfg(not(feature = "kornia"))]
+        DetectorKind::Kornia => {
+            return Err(DetectError::Failed("this pushbot was built without the `kornia` feature".into()));
+        }
     })
 }

@@ -62,7 +62,7 @@ pub fn fit_dlt(src: &[[f64; 2]], dst: &[[f64; 2]]) -> Result<Homography, FitErro
     let (imin, smin) = svd.singular_values.iter().enumerate().fold((0, f64::INFINITY), |b, (i, &s)| if s < b.1 { (i, s) } else { b });
     // A second (near) null direction means the points do not pin down a homography.
     let second = svd.singular_values.iter().enumerate().filter(|(i, _)| *i != imin).map(|(_, &s)| s).fold(f64::INFINITY, f64::min);
-    if !(second > 1e-9 * svd.singular_values.max()) || !smin.is_finite() {
+    if second.partial_cmp(&(1e-9 * svd.singular_values.max())) != Some(std::cmp::Ordering::Greater) || !smin.is_finite() {
         return Err(FitError::Degenerate);
     }
     let h = vt.row(imin);
@@ -166,8 +166,12 @@ mod tests {
             let (a, b) = (fit.apply(p).unwrap(), h.apply(p).unwrap());
             assert!((a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6, "{a:?} vs {b:?}");
         }
-        // Four points are enough.
-        assert!(fit_homography(&src[..4], &dst[..4]).is_ok());
+        // Four points in general position are enough.
+        let four = [0, 2, 6, 8];
+        let (s4, d4): (Vec<_>, Vec<_>) = four.iter().map(|&i| (src[i], dst[i])).unzip();
+        let fit4 = fit_homography(&s4, &d4).unwrap();
+        let (a, b) = (fit4.apply([0.5, 0.5]).unwrap(), h.apply([0.5, 0.5]).unwrap());
+        assert!((a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6);
     }
 
     #[test]

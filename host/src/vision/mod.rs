@@ -4,7 +4,7 @@
 //!
 //! - [`source`]: frame sources behind [`source::FrameSource`] (V4L2, image folder, sim socket);
 //! - [`detect`]: detectors behind [`detect::Detector`]: the reference C AprilTag ([`apriltag`],
-//!   the default) and the pure-Rust `kornia-apriltag` ([`kornia`]);
+//!   the default) and, with the `kornia` feature, the pure-Rust `kornia-apriltag` (`kornia`);
 //! - [`homography`] and [`calibration`]: pixel → table-plane homography from markers at known
 //!   places;
 //! - [`layout`]: which marker is where (until the shared scene format carries it);
@@ -17,6 +17,7 @@ pub mod calibration;
 pub mod detect;
 pub mod folder;
 pub mod homography;
+#[cfg(feature = "kornia")]
 pub mod kornia;
 pub mod layout;
 pub mod simsocket;
@@ -61,8 +62,8 @@ pub fn measure(dets: &[Detection], cal: &Calibration, layout: &MarkerLayout) -> 
             continue;
         }
         let m = Measurement { body: bm.body.clone(), marker: d.id, marker_pose, body_pose: bm.body_pose(&marker_pose) };
-        match best.iter_mut().find(|(_, b)| b.body == m.body) {
-            Some(slot) if slot.0 < d.margin => *slot = (d.margin, m),
+        match best.iter().position(|(_, b)| b.body == m.body) {
+            Some(i) if best[i].0 < d.margin => best[i] = (d.margin, m),
             Some(_) => {}
             None => best.push((d.margin, m)),
         }

@@ -186,6 +186,8 @@ impl Tracker {
                 (Some(mut t), obs) => {
                     let dt = (time - t.time).max(0.0);
                     let prior = Motion::new(dt, &self.params).predict(&t.est);
+                    // Keep the covariance exactly symmetric (the library checks it).
+                    let prior = StateAndCovariance::new(*prior.state(), prior.covariance().symmetric_part());
                     t.time = time;
                     t.est = prior;
                     if let Some(z) = obs {
@@ -230,7 +232,7 @@ impl Tracker {
         let innov = zv - self.observe.h * x;
         let s = self.observe.h * prior.covariance() * self.observe.ht + self.observe.r;
         let d2 = s.cholesky()?.solve(&innov).dot(&innov);
-        if !(d2 <= self.params.gate) {
+        if d2.is_nan() || d2 > self.params.gate {
             return None;
         }
         let post = self.observe.update(prior, &zv, CovarianceUpdateMethod::JosephForm).ok()?;

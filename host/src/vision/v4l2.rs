@@ -11,6 +11,9 @@ use linuxvideo::{BufType, Device};
 
 use super::source::{Frame, FrameSource, SourceError};
 
+/// 8-bit gray (`V4L2_PIX_FMT_GREY`).
+const GREY: PixelFormat = PixelFormat::from_fourcc(*b"GREY");
+
 /// What to ask the camera for.
 #[derive(Debug, Clone, Copy)]
 pub struct V4l2Request {
@@ -61,7 +64,7 @@ impl V4l2Source {
         let device = Device::open(path).map_err(|e| bad("cannot open it as a V4L2 device", e))?;
         let formats: Vec<PixelFormat> =
             device.formats(BufType::VIDEO_CAPTURE).filter_map(|f| f.ok().map(|f| f.pixel_format())).collect();
-        let format = [PixelFormat::MJPG, PixelFormat::YUYV, PixelFormat::GREY]
+        let format = [PixelFormat::MJPG, PixelFormat::YUYV, GREY]
             .into_iter()
             .find(|f| formats.contains(f))
             .ok_or_else(|| {
@@ -126,7 +129,7 @@ fn to_gray(data: &[u8], w: usize, h: usize, bpl: usize, fmt: PixelFormat) -> Res
         }
         return Ok(img.into_raw());
     }
-    let bytes_per_px = if fmt == PixelFormat::YUYV { 2 } else { 1 };
+    let bytes_per_px = if fmt == PixelFormat::YUYV { 2 } else { 1 }; // else GREY
     let bpl = bpl.max(w * bytes_per_px);
     if data.len() < bpl * (h - 1) + w * bytes_per_px {
         return Err(format!("short frame: {} bytes for {w}x{h}", data.len()));

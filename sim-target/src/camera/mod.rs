@@ -7,6 +7,7 @@
 //! the table and its exact corners in pixels (pixel centres at `i + 0.5`). Frames can be written
 //! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
 
+pub mod families;
 pub mod render;
 pub mod server;
 
@@ -197,7 +198,7 @@ impl Camera {
         if config.model.table_to_pixel.inverse().is_none() {
             return Err(CameraError::Invalid("table→pixel homography is singular".into()));
         }
-        if !(config.fps > 0.0) || config.model.width == 0 || config.model.height == 0 {
+        if !(config.fps.is_finite() && config.fps > 0.0) || config.model.width == 0 || config.model.height == 0 {
             return Err(CameraError::Invalid("frame rate and image size must be positive".into()));
         }
         Ok(Camera { config, codes: TagCodes::new().map_err(CameraError::Invalid)?, rng: ChaCha8Rng::seed_from_u64(seed), seq: 0 })

@@ -2,10 +2,10 @@
 //! markers drawn by supersampling each pixel (pixel centres at `i + 0.5`), then the optics and
 //! the sensor: Gaussian blur, exposure, seeded noise, 8-bit quantisation.
 //!
-//! Marker bit patterns come from the tag family data that `kornia-apriltag` ships, laid out
-//! exactly as the reference AprilTag library's `apriltag_to_image` does.
+//! Marker bit patterns come from the AprilTag library's family data ([`super::families`]), laid
+//! out exactly as its `apriltag_to_image` does.
 
-use kornia_apriltag::family::TagFamily;
+use super::families::{FamilyData, TAG25H9, TAG36H11};
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
@@ -117,32 +117,26 @@ pub struct Polygon {
     pub shade: f64,
 }
 
-/// Bit patterns of the supported families, read once.
-#[derive(Debug, Clone)]
-pub struct TagCodes {
-    tag36h11: TagFamily,
-    tag25h9: TagFamily,
-}
+/// Bit patterns of the supported families.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TagCodes;
 
 impl TagCodes {
-    /// Load the family tables.
+    /// The family tables.
     pub fn new() -> Result<TagCodes, String> {
-        Ok(TagCodes {
-            tag36h11: TagFamily::tag36_h11().map_err(|e| e.to_string())?,
-            tag25h9: TagFamily::tag25_h9().map_err(|e| e.to_string())?,
-        })
+        Ok(TagCodes)
     }
 
-    fn family(&self, f: MarkerFamily) -> &TagFamily {
+    fn family(&self, f: MarkerFamily) -> &'static FamilyData {
         match f {
-            MarkerFamily::Tag36h11 => &self.tag36h11,
-            MarkerFamily::Tag25h9 => &self.tag25h9,
+            MarkerFamily::Tag36h11 => &TAG36H11,
+            MarkerFamily::Tag25h9 => &TAG25H9,
         }
     }
 
     /// Number of ids in a family.
     pub fn len(&self, f: MarkerFamily) -> usize {
-        self.family(f).code_data.len()
+        self.family(f).codes.len()
     }
 
     /// Whether a family has no ids (never, for the built-in ones).
@@ -154,7 +148,7 @@ impl TagCodes {
     /// `true` = white, and the width of its black square in cells; as `apriltag_to_image`.
     pub fn pattern(&self, f: MarkerFamily, id: u32) -> Option<(Vec<bool>, usize, usize)> {
         let fam = self.family(f);
-        let code = *fam.code_data.get(id as usize)? as u64;
+        let code = *fam.codes.get(id as usize)?;
         let tw = fam.total_width;
         let mut im = vec![false; tw * tw];
         let wbw = fam.width_at_border + if fam.reversed_border { 0 } else { 2 };
@@ -166,10 +160,10 @@ impl TagCodes {
             im[(wbs + 1 + i) * tw + wbs] = true;
         }
         let bs = (tw - fam.width_at_border) / 2;
-        for i in 0..fam.nbits {
+        for (i, (&bx, &by)) in fam.bit_x.iter().zip(fam.bit_y).enumerate().take(fam.nbits) {
             if code & (1u64 << (fam.nbits - i - 1)) != 0 {
-                let x = fam.bit_x[i] as isize + bs as isize;
-                let y = fam.bit_y[i] as isize + bs as isize;
+                let x = bx as isize + bs as isize;
+                let y = by as isize + bs as isize;
                 if (0..tw as isize).contains(&x) && (0..tw as isize).contains(&y) {
                     im[y as usize * tw + x as usize] = true;
                 }
@@ -275,8 +269,8 @@ impl Canvas {
             for j in 0..n {
                 let yy = y as f64 + (j as f64 + 0.5) / n as f64;
                 xs.clear();
-                for i in 0..px.len() {
-                    let (a, b) = (px[i], px[(i + 1) % px.len()]);
+                for (i, &a) in px.iter().enumerate() {
+                    let b = px[(i + 1) % px.len()];
                     if (a[1] > yy) != (b[1] > yy) {
                         xs.push(a[0] + (yy - a[1]) * (b[0] - a[0]) / (b[1] - a[1]));
                     }
@@ -452,13 +446,14 @@ mod tests {
             assert!(!p[tw + i] && !p[(tw - 2) * tw + i] && !p[i * tw + 1] && !p[i * tw + tw - 2], "black ring");
         }
         // Bits read back in the family's order give the code.
-        let fam = TagFamily::tag36_h11().unwrap();
+        let fam = &TAG36H11;
         let mut code = 0u64;
-        for i in 0..36 {
-            let (x, y) = (fam.bit_x[i] as usize + 1, fam.bit_y[i] as usize + 1);
+        for (&bx, &by) in fam.bit_x.iter().zip(fam.bit_y) {
+            let (x, y) = (bx as usize + 1, by as usize + 1);
             code = (code << 1) | p[y * tw + x] as u64;
         }
-        assert_eq!(code, fam.code_data[0] as u64);
+        assert_eq!(code, fam.codes[0]);
+        assert_eq!(code, 0x0000000d7e00984b, "tag36h11 id 0 as published");
         assert!(codes.pattern(MarkerFamily::Tag36h11, 587).is_none());
     }
 
