@@ -7,12 +7,12 @@ use pushbot::vision::folder::FolderSource;
 #[cfg(feature = "kornia")]
 use pushbot::vision::kornia::{KorniaConfig, KorniaDetector};
 use pushbot::vision::layout::MarkerLayout;
+use pushbot::vision::measure;
 use pushbot::vision::simsocket::SimSocketSource;
 use pushbot::vision::source::{FrameSource, SourceError, open_source};
 use pushbot::vision::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
-use pushbot::vision::measure;
-use pushbot_sim::camera::server::CameraServer;
 use pushbot_sim::camera::CameraFrame;
+use pushbot_sim::camera::server::CameraServer;
 
 /// Issue 5's acceptance: on 300 rendered frames, body position error median ≤ 1.5 mm and 99th
 /// percentile ≤ 4 mm, heading median ≤ 0.5°, ≥ 99.5 % of fully visible markers found, no
@@ -23,7 +23,10 @@ fn accuracy_on_rendered_frames() {
     let layout = MarkerLayout::default_table();
     let frames = synth::frames(&layout, 300, 42, &SynthParams::default()).unwrap();
     let mut det = AprilTagC::new(&layout.families(), &AprilTagCConfig::default()).unwrap();
-    let dets: Vec<_> = frames.iter().map(|f| det.detect(&f.frame).unwrap()).collect();
+    let dets: Vec<_> = frames
+        .iter()
+        .map(|f| det.detect(&f.frame).unwrap())
+        .collect();
     let cal = synth::calibrate(&dets[..5], &layout, [960, 720]).unwrap();
     assert!(cal.rms_px < 0.2, "calibration RMS {} px", cal.rms_px);
     let mut score = DetectionScore::default();
@@ -43,8 +46,17 @@ fn accuracy_on_rendered_frames() {
         score.corner_bias,
         quantile(&poses.heading_deg, 0.99)
     );
-    assert_eq!(score.visible, 300 * 10, "every marker is drawn fully visible");
-    assert!(score.rate() >= 0.995, "found {}/{}", score.found, score.visible);
+    assert_eq!(
+        score.visible,
+        300 * 10,
+        "every marker is drawn fully visible"
+    );
+    assert!(
+        score.rate() >= 0.995,
+        "found {}/{}",
+        score.found,
+        score.visible
+    );
     assert_eq!(score.wrong_ids, 0);
     assert!(med <= 1.5, "position median {med} mm");
     assert!(p99 <= 4.0, "position p99 {p99} mm");
@@ -58,14 +70,36 @@ fn accuracy_on_rendered_frames() {
 fn kornia_candidate_agrees_on_corners() {
     let layout = MarkerLayout::default_table();
     let frames = synth::frames(&layout, 10, 7, &SynthParams::default()).unwrap();
-    let mut det = KorniaDetector::new(&layout.families(), &KorniaConfig { threshold_split: Some(0.5), downscale: None }).unwrap();
+    let mut det = KorniaDetector::new(
+        &layout.families(),
+        &KorniaConfig {
+            threshold_split: Some(0.5),
+            downscale: None,
+        },
+    )
+    .unwrap();
     let mut score = DetectionScore::default();
     for f in &frames {
         score.add(&det.detect(&f.frame).unwrap(), &f.markers);
     }
-    eprintln!("kornia: found {}/{}, corner rms {:.3} px, bias {:?}", score.found, score.visible, score.corner_rms(), score.corner_bias);
-    assert!(score.rate() > 0.8, "found {}/{}", score.found, score.visible);
-    assert!(score.corner_rms() < 1.0, "corner rms {}", score.corner_rms());
+    eprintln!(
+        "kornia: found {}/{}, corner rms {:.3} px, bias {:?}",
+        score.found,
+        score.visible,
+        score.corner_rms(),
+        score.corner_bias
+    );
+    assert!(
+        score.rate() > 0.8,
+        "found {}/{}",
+        score.found,
+        score.visible
+    );
+    assert!(
+        score.corner_rms() < 1.0,
+        "corner rms {}",
+        score.corner_rms()
+    );
     assert_eq!(score.wrong_ids, 0);
 }
 
@@ -101,7 +135,10 @@ fn folder_source_reads_rendered_pngs() {
     }
     assert!(src.next_frame().unwrap().is_none());
     let empty = tempfile::tempdir().unwrap();
-    assert!(matches!(FolderSource::open(empty.path(), 30.0), Err(SourceError::BadSource(_))));
+    assert!(matches!(
+        FolderSource::open(empty.path(), 30.0),
+        Err(SourceError::BadSource(_))
+    ));
 }
 
 #[test]
@@ -130,7 +167,9 @@ fn sim_socket_source_receives_frames() {
 
 #[test]
 fn missing_v4l2_device_is_a_clear_bad_input() {
-    let err = open_source("/dev/video-pushbot-missing", 30.0).err().expect("no such device");
+    let err = open_source("/dev/video-pushbot-missing", 30.0)
+        .err()
+        .expect("no such device");
     match err {
         SourceError::BadSource(msg) => assert!(msg.contains("does not exist"), "{msg}"),
         other => panic!("expected BadSource, got {other:?}"),
@@ -155,24 +194,60 @@ fn cli_calibrate_and_track_on_a_folder() {
     let bin = env!("CARGO_BIN_EXE_pushbot");
     let cam = dir.path().to_str().unwrap();
     let out = std::process::Command::new(bin)
-        .args(["calibrate", "--camera", cam, "--out", cal.to_str().unwrap(), "--json"])
+        .args([
+            "calibrate",
+            "--camera",
+            cam,
+            "--out",
+            cal.to_str().unwrap(),
+            "--json",
+        ])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["rms_px"].as_f64().unwrap() < 0.2);
     let out = std::process::Command::new(bin)
-        .args(["track", "--camera", cam, "--calibration", cal.to_str().unwrap(), "--json"])
+        .args([
+            "track",
+            "--camera",
+            cam,
+            "--calibration",
+            cal.to_str().unwrap(),
+            "--json",
+        ])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
-    let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
     assert_eq!(lines.len(), 4);
-    let truth = synth::frames(&MarkerLayout::default_table(), 4, 3, &SynthParams::default()).unwrap();
+    let truth = synth::frames(
+        &MarkerLayout::default_table(),
+        4,
+        3,
+        &SynthParams::default(),
+    )
+    .unwrap();
     for (l, f) in lines.iter().zip(&truth) {
         assert!((l["time"].as_f64().unwrap() - 10.0 - f.frame.time).abs() < 1e-9);
-        let robot = l["bodies"].as_array().unwrap().iter().find(|b| b["id"] == "robot").unwrap();
+        let robot = l["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|b| b["id"] == "robot")
+            .unwrap();
         let (name, pose) = &f.bodies[0];
         assert_eq!(name, "robot");
         // Each frame places the robot anew: the first frame is exact, later ones are followed
@@ -185,7 +260,13 @@ fn cli_calibrate_and_track_on_a_folder() {
     }
     // A missing calibration file is bad input.
     let out = std::process::Command::new(bin)
-        .args(["track", "--camera", cam, "--calibration", "/nonexistent/cal.json"])
+        .args([
+            "track",
+            "--camera",
+            cam,
+            "--calibration",
+            "/nonexistent/cal.json",
+        ])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));

@@ -99,16 +99,22 @@ fn calibrate_from(
     lay: &MarkerLayout,
     n: usize,
 ) -> Result<Result<Calibration, String>, CliError> {
-    let mut det = make_detector(args.detector, &lay.families()).map_err(|e| CliError::Failed(e.into()))?;
+    let mut det =
+        make_detector(args.detector, &lay.families()).map_err(|e| CliError::Failed(e.into()))?;
     let mut all = Vec::new();
     let mut size = [0, 0];
     while all.len() < n.max(1) {
-        let Some(frame) = src.next_frame().map_err(read_err)? else { break };
+        let Some(frame) = src.next_frame().map_err(read_err)? else {
+            break;
+        };
         size = [frame.width, frame.height];
         all.push(det.detect(&frame).map_err(|e| CliError::Failed(e.into()))?);
     }
     if all.is_empty() {
-        return Err(CliError::bad_input(format!("{} gave no frames to calibrate from", src.describe())));
+        return Err(CliError::bad_input(format!(
+            "{} gave no frames to calibrate from",
+            src.describe()
+        )));
     }
     Ok(Calibration::fit(&all, lay, size).map_err(|e| e.to_string()))
 }
@@ -124,7 +130,8 @@ pub fn calibrate(g: &Global, args: CalibrateArgs) -> CliResult {
             return Ok(Status::TaskFailed);
         }
     };
-    cal.save(&args.out).map_err(|e| CliError::Failed(e.into()))?;
+    cal.save(&args.out)
+        .map_err(|e| CliError::Failed(e.into()))?;
     if g.json {
         let v = serde_json::json!({"calibration": args.out, "rms_px": cal.rms_px, "max_px": cal.max_px,
             "mm_per_px": cal.mm_per_px, "markers": cal.markers, "points": cal.points});
@@ -157,13 +164,18 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
             }
         },
     };
-    let det = make_detector(args.camera.detector, &lay.families()).map_err(|e| CliError::Failed(e.into()))?;
+    let det = make_detector(args.camera.detector, &lay.families())
+        .map_err(|e| CliError::Failed(e.into()))?;
     let mut pipe = Pipeline::new(det, lay, cal, TrackerParams::default());
     let mut out = std::io::stdout().lock();
     let mut count = 0;
     while args.frames.is_none_or(|n| count < n) {
-        let Some(frame) = src.next_frame().map_err(read_err)? else { break };
-        let r = pipe.process(&frame).map_err(|e| CliError::Failed(e.into()))?;
+        let Some(frame) = src.next_frame().map_err(read_err)? else {
+            break;
+        };
+        let r = pipe
+            .process(&frame)
+            .map_err(|e| CliError::Failed(e.into()))?;
         let line = TrackLine::from(&r);
         let text = if g.json {
             serde_json::to_string(&line).map_err(|e| CliError::Failed(e.into()))?
@@ -171,7 +183,16 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
             let bodies: Vec<String> = line
                 .bodies
                 .iter()
-                .map(|b| format!("{} ({:.4}, {:.4}, {:.1}°){}", b.id, b.x, b.y, b.theta.to_degrees(), if b.seen { "" } else { " unseen" }))
+                .map(|b| {
+                    format!(
+                        "{} ({:.4}, {:.4}, {:.1}°){}",
+                        b.id,
+                        b.x,
+                        b.y,
+                        b.theta.to_degrees(),
+                        if b.seen { "" } else { " unseen" }
+                    )
+                })
                 .collect();
             format!("t={:.3}s {}", line.time, bodies.join("  "))
         };
@@ -189,12 +210,20 @@ pub fn bench(g: &Global, cmd: BenchCommand) -> CliResult {
         BenchCommand::Vision { frames } => {
             let r = bench::run(frames, g.seed).map_err(|e| CliError::Failed(anyhow::anyhow!(e)))?;
             if g.json {
-                println!("{}", serde_json::to_string(&r).map_err(|e| CliError::Failed(e.into()))?);
+                println!(
+                    "{}",
+                    serde_json::to_string(&r).map_err(|e| CliError::Failed(e.into()))?
+                );
             } else {
                 println!("{} frames {}x{}, one core", r.frames, r.size[0], r.size[1]);
                 println!(
                     "pipeline ({}): {:.2} ms/frame mean, {:.2} median; position error median {:.3} mm, p99 {:.3} mm; heading median {:.3}°",
-                    r.pipeline, r.pipeline_ms_mean, r.pipeline_ms_median, r.position_mm[0], r.position_mm[1], r.heading_deg[0]
+                    r.pipeline,
+                    r.pipeline_ms_mean,
+                    r.pipeline_ms_median,
+                    r.position_mm[0],
+                    r.position_mm[1],
+                    r.heading_deg[0]
                 );
                 for d in &r.detectors {
                     println!(

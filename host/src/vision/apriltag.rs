@@ -28,7 +28,14 @@ pub struct AprilTagCConfig {
 
 impl Default for AprilTagCConfig {
     fn default() -> Self {
-        AprilTagCConfig { decimate: 2.0, sigma: 0.0, refine_edges: true, threads: 1, bits_36h11: 2, bits_25h9: 1 }
+        AprilTagCConfig {
+            decimate: 2.0,
+            sigma: 0.0,
+            refine_edges: true,
+            threads: 1,
+            bits_36h11: 2,
+            bits_25h9: 1,
+        }
     }
 }
 
@@ -40,7 +47,12 @@ pub struct AprilTagC {
 
 impl std::fmt::Debug for AprilTagC {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("AprilTagC").field("families", &self.detectors.iter().map(|d| d.0).collect::<Vec<_>>()).finish()
+        f.debug_struct("AprilTagC")
+            .field(
+                "families",
+                &self.detectors.iter().map(|d| d.0).collect::<Vec<_>>(),
+            )
+            .finish()
     }
 }
 
@@ -51,17 +63,24 @@ impl AprilTagC {
         for &fam in families {
             let builder = DetectorBuilder::new();
             let builder = match fam {
-                MarkerFamily::Tag36h11 => builder.add_family_bits(Family::tag_36h11(), cfg.bits_36h11),
+                MarkerFamily::Tag36h11 => {
+                    builder.add_family_bits(Family::tag_36h11(), cfg.bits_36h11)
+                }
                 MarkerFamily::Tag25h9 => builder.add_family_bits(Family::tag_25h9(), cfg.bits_25h9),
             };
-            let mut d = builder.build().map_err(|e| DetectError::Failed(format!("{e}")))?;
+            let mut d = builder
+                .build()
+                .map_err(|e| DetectError::Failed(format!("{e}")))?;
             d.set_decimation(cfg.decimate);
             d.set_sigma(cfg.sigma);
             d.set_refine_edges(cfg.refine_edges);
             d.set_thread_number(cfg.threads.max(1));
             detectors.push((fam, d));
         }
-        Ok(AprilTagC { detectors, image: None })
+        Ok(AprilTagC {
+            detectors,
+            image: None,
+        })
     }
 }
 
@@ -73,14 +92,22 @@ impl Detector for AprilTagC {
     fn detect(&mut self, frame: &Frame) -> Result<Vec<Detection>, DetectError> {
         let (w, h) = (frame.width as usize, frame.height as usize);
         if frame.pixels.len() != w * h {
-            return Err(DetectError::Failed("frame buffer does not match its size".into()));
+            return Err(DetectError::Failed(
+                "frame buffer does not match its size".into(),
+            ));
         }
-        let reuse = self.image.as_ref().is_some_and(|im| im.width() == w && im.height() == h);
+        let reuse = self
+            .image
+            .as_ref()
+            .is_some_and(|im| im.width() == w && im.height() == h);
         if !reuse {
-            let im = Image::zeros_with_alignment(w, h, 96).map_err(|e| DetectError::Failed(format!("{e}")))?;
+            let im = Image::zeros_with_alignment(w, h, 96)
+                .map_err(|e| DetectError::Failed(format!("{e}")))?;
             self.image = Some(im);
         }
-        let Some(image) = self.image.as_mut() else { return Err(DetectError::Failed("no image buffer".into())) };
+        let Some(image) = self.image.as_mut() else {
+            return Err(DetectError::Failed("no image buffer".into()));
+        };
         let stride = image.stride();
         let buf = image.as_slice_mut();
         for (row, src) in frame.pixels.chunks_exact(w).enumerate() {

@@ -59,7 +59,11 @@ pub struct VisionBench {
     pub detectors: Vec<DetectorFigures>,
 }
 
-fn time_detector(d: &mut dyn Detector, name: String, frames: &[synth::SynthFrame]) -> Result<(DetectorFigures, Vec<Vec<Detection>>), String> {
+fn time_detector(
+    d: &mut dyn Detector,
+    name: String,
+    frames: &[synth::SynthFrame],
+) -> Result<(DetectorFigures, Vec<Vec<Detection>>), String> {
     let mut ms = Vec::with_capacity(frames.len());
     let mut score = DetectionScore::default();
     let mut all = Vec::with_capacity(frames.len());
@@ -90,13 +94,24 @@ pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
     let families = layout.families();
     let mut detectors = Vec::new();
 
-    let mut c = AprilTagC::new(&families, &AprilTagCConfig::default()).map_err(|e| e.to_string())?;
-    let (fig, c_dets) = time_detector(&mut c, "apriltag-c (reference, quad_decimate 2)".into(), &frames)?;
+    let mut c =
+        AprilTagC::new(&families, &AprilTagCConfig::default()).map_err(|e| e.to_string())?;
+    let (fig, c_dets) = time_detector(
+        &mut c,
+        "apriltag-c (reference, quad_decimate 2)".into(),
+        &frames,
+    )?;
     detectors.push(fig);
     #[cfg(feature = "kornia")]
     for (name, cfg) in [
         ("kornia-apriltag (defaults)", KorniaConfig::default()),
-        ("kornia-apriltag (threshold_split 0.5)", KorniaConfig { threshold_split: Some(0.5), downscale: None }),
+        (
+            "kornia-apriltag (threshold_split 0.5)",
+            KorniaConfig {
+                threshold_split: Some(0.5),
+                downscale: None,
+            },
+        ),
     ] {
         let mut k = KorniaDetector::new(&families, &cfg).map_err(|e| e.to_string())?;
         detectors.push(time_detector(&mut k, name.into(), &frames)?.0);
@@ -108,7 +123,9 @@ pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
         poses.add(&measure(dets, &cal, &layout), &f.bodies);
     }
     let mut pipeline = Pipeline::new(
-        Box::new(AprilTagC::new(&families, &AprilTagCConfig::default()).map_err(|e| e.to_string())?),
+        Box::new(
+            AprilTagC::new(&families, &AprilTagCConfig::default()).map_err(|e| e.to_string())?,
+        ),
         layout.clone(),
         cal.clone(),
         TrackerParams::default(),
@@ -126,7 +143,10 @@ pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
         pipeline_ms_mean: ms.iter().sum::<f64>() / ms.len().max(1) as f64,
         pipeline_ms_median: quantile(&ms, 0.5),
         position_mm: [quantile(&poses.pos_mm, 0.5), quantile(&poses.pos_mm, 0.99)],
-        heading_deg: [quantile(&poses.heading_deg, 0.5), quantile(&poses.heading_deg, 0.99)],
+        heading_deg: [
+            quantile(&poses.heading_deg, 0.5),
+            quantile(&poses.heading_deg, 0.99),
+        ],
         calibration_rms_px: cal.rms_px,
         detectors,
     })

@@ -57,13 +57,19 @@ pub enum CalibrationError {
 impl Calibration {
     /// Fit from the detections of one or more frames of the same still scene: every sighting of
     /// a calibration marker contributes its four corners and its centre.
-    pub fn fit(frames: &[Vec<Detection>], layout: &MarkerLayout, image_size: [u32; 2]) -> Result<Calibration, CalibrationError> {
+    pub fn fit(
+        frames: &[Vec<Detection>],
+        layout: &MarkerLayout,
+        image_size: [u32; 2],
+    ) -> Result<Calibration, CalibrationError> {
         let mut table = Vec::new();
         let mut pixel = Vec::new();
         let mut ids = BTreeSet::new();
         for dets in frames {
             for d in dets {
-                let Some(m) = layout.fixed_marker(d.family, d.id) else { continue };
+                let Some(m) = layout.fixed_marker(d.family, d.id) else {
+                    continue;
+                };
                 let p = m.placement();
                 table.extend(p.corners());
                 table.push(p.centre);
@@ -78,18 +84,29 @@ impl Calibration {
                 known: layout.calibration.iter().map(|m| m.id).collect(),
             });
         }
-        let table_to_pixel = fit_homography(&table, &pixel).map_err(|e| CalibrationError::Fit(e.to_string()))?;
-        let pixel_to_table = table_to_pixel.inverse().ok_or_else(|| CalibrationError::Fit("singular homography".into()))?;
+        let table_to_pixel =
+            fit_homography(&table, &pixel).map_err(|e| CalibrationError::Fit(e.to_string()))?;
+        let pixel_to_table = table_to_pixel
+            .inverse()
+            .ok_or_else(|| CalibrationError::Fit("singular homography".into()))?;
         let errs = reprojection_errors(&table_to_pixel, &table, &pixel);
         let rms_px = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
         let max_px = errs.iter().cloned().fold(0.0, f64::max);
         let c = [image_size[0] as f64 / 2.0, image_size[1] as f64 / 2.0];
-        let mm_per_px = match (pixel_to_table.apply(c), pixel_to_table.apply([c[0] + 1.0, c[1]]), pixel_to_table.apply([c[0], c[1] + 1.0])) {
-            (Some(a), Some(b), Some(d)) => 500.0 * ((b[0] - a[0]).hypot(b[1] - a[1]) + (d[0] - a[0]).hypot(d[1] - a[1])),
+        let mm_per_px = match (
+            pixel_to_table.apply(c),
+            pixel_to_table.apply([c[0] + 1.0, c[1]]),
+            pixel_to_table.apply([c[0], c[1] + 1.0]),
+        ) {
+            (Some(a), Some(b), Some(d)) => {
+                500.0 * ((b[0] - a[0]).hypot(b[1] - a[1]) + (d[0] - a[0]).hypot(d[1] - a[1]))
+            }
             _ => f64::NAN,
         };
         if !rms_px.is_finite() || !mm_per_px.is_finite() {
-            return Err(CalibrationError::Fit("the fitted homography sends points to infinity".into()));
+            return Err(CalibrationError::Fit(
+                "the fitted homography sends points to infinity".into(),
+            ));
         }
         Ok(Calibration {
             version: 1,
@@ -106,20 +123,33 @@ impl Calibration {
 
     /// Write as pretty JSON.
     pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
-        let text = serde_json::to_string_pretty(self).map_err(|e| CalibrationError::File(e.to_string()))?;
-        std::fs::write(path, text).map_err(|e| CalibrationError::File(format!("cannot write {}: {e}", path.display())))
+        let text = serde_json::to_string_pretty(self)
+            .map_err(|e| CalibrationError::File(e.to_string()))?;
+        std::fs::write(path, text)
+            .map_err(|e| CalibrationError::File(format!("cannot write {}: {e}", path.display())))
     }
 
     /// Read and check a saved calibration.
     pub fn load(path: &Path) -> Result<Calibration, CalibrationError> {
-        let text = std::fs::read_to_string(path).map_err(|e| CalibrationError::File(format!("cannot read {}: {e}", path.display())))?;
-        let c: Calibration =
-            serde_json::from_str(&text).map_err(|e| CalibrationError::File(format!("{}: not a calibration: {e}", path.display())))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CalibrationError::File(format!("cannot read {}: {e}", path.display())))?;
+        let c: Calibration = serde_json::from_str(&text).map_err(|e| {
+            CalibrationError::File(format!("{}: not a calibration: {e}", path.display()))
+        })?;
         if c.version != 1 {
-            return Err(CalibrationError::File(format!("{}: unknown calibration version {}", path.display(), c.version)));
+            return Err(CalibrationError::File(format!(
+                "{}: unknown calibration version {}",
+                path.display(),
+                c.version
+            )));
         }
-        if c.pixel_to_table.inverse().is_none() || c.pixel_to_table.0.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(CalibrationError::File(format!("{}: the homography is singular", path.display())));
+        if c.pixel_to_table.inverse().is_none()
+            || c.pixel_to_table.0.iter().flatten().any(|v| !v.is_finite())
+        {
+            return Err(CalibrationError::File(format!(
+                "{}: the homography is singular",
+                path.display()
+            )));
         }
         Ok(c)
     }
@@ -146,7 +176,8 @@ impl Calibration {
         let theta = scross.atan2(sdot);
         // Half-side from the corner radius: |corner| = half·√2, over 4 corners.
         let side = 2.0 * (norm / 4.0).sqrt() / std::f64::consts::SQRT_2;
-        (cx.is_finite() && cy.is_finite() && theta.is_finite()).then_some((Pose::new(cx, cy, theta), side))
+        (cx.is_finite() && cy.is_finite() && theta.is_finite())
+            .then_some((Pose::new(cx, cy, theta), side))
     }
 }
 
@@ -156,7 +187,14 @@ mod tests {
     use pushbot_sim::camera::{CameraModel, MarkerFamily};
 
     fn det(id: u32, corners: [[f64; 2]; 4], centre: [f64; 2]) -> Detection {
-        Detection { family: MarkerFamily::Tag36h11, id, corners, centre, hamming: 0, margin: 50.0 }
+        Detection {
+            family: MarkerFamily::Tag36h11,
+            id,
+            corners,
+            centre,
+            hamming: 0,
+            margin: 50.0,
+        }
     }
 
     /// Exact detections of the calibration markers seen through a known (tilted) camera give
@@ -171,7 +209,11 @@ mod tests {
             .iter()
             .map(|m| {
                 let p = m.placement();
-                det(m.id, p.corners().map(|c| h.apply(c).unwrap()), h.apply(p.centre).unwrap())
+                det(
+                    m.id,
+                    p.corners().map(|c| h.apply(c).unwrap()),
+                    h.apply(p.centre).unwrap(),
+                )
             })
             .collect();
         let cal = Calibration::fit(&[dets], &layout, [960, 720]).unwrap();
@@ -183,9 +225,25 @@ mod tests {
             assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6);
         }
         assert!((cal.mm_per_px - 1.31).abs() < 0.05, "{}", cal.mm_per_px);
-        let body = pushbot_sim::camera::MarkerPlacement { id: 10, family: MarkerFamily::Tag36h11, centre: [0.4, 0.3], heading: 2.5, side: 0.05 };
-        let (pose, side) = cal.marker_pose(&det(10, body.corners().map(|c| h.apply(c).unwrap()), [0.0; 2])).unwrap();
-        assert!((pose.x - 0.4).abs() < 1e-9 && (pose.y - 0.3).abs() < 1e-9 && (pose.theta - 2.5).abs() < 1e-9);
+        let body = pushbot_sim::camera::MarkerPlacement {
+            id: 10,
+            family: MarkerFamily::Tag36h11,
+            centre: [0.4, 0.3],
+            heading: 2.5,
+            side: 0.05,
+        };
+        let (pose, side) = cal
+            .marker_pose(&det(
+                10,
+                body.corners().map(|c| h.apply(c).unwrap()),
+                [0.0; 2],
+            ))
+            .unwrap();
+        assert!(
+            (pose.x - 0.4).abs() < 1e-9
+                && (pose.y - 0.3).abs() < 1e-9
+                && (pose.theta - 2.5).abs() < 1e-9
+        );
         assert!((side - 0.05).abs() < 1e-9);
         // Save and load.
         let dir = tempfile::tempdir().unwrap();
@@ -193,7 +251,13 @@ mod tests {
         cal.save(&path).unwrap();
         let back = Calibration::load(&path).unwrap();
         assert_eq!(back.markers, cal.markers);
-        for (a, b) in back.pixel_to_table.0.iter().flatten().zip(cal.pixel_to_table.0.iter().flatten()) {
+        for (a, b) in back
+            .pixel_to_table
+            .0
+            .iter()
+            .flatten()
+            .zip(cal.pixel_to_table.0.iter().flatten())
+        {
             assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()));
         }
         std::fs::write(&path, "{}").unwrap();
@@ -203,7 +267,14 @@ mod tests {
     #[test]
     fn too_few_markers_is_an_error() {
         let layout = MarkerLayout::default_table();
-        let dets = vec![det(0, [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]], [1.5, 1.5])];
-        assert!(matches!(Calibration::fit(&[dets], &layout, [960, 720]), Err(CalibrationError::TooFewMarkers { .. })));
+        let dets = vec![det(
+            0,
+            [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]],
+            [1.5, 1.5],
+        )];
+        assert!(matches!(
+            Calibration::fit(&[dets], &layout, [960, 720]),
+            Err(CalibrationError::TooFewMarkers { .. })
+        ));
     }
 }

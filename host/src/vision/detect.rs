@@ -39,7 +39,9 @@ pub enum DetectError {
 }
 
 /// Which detector to build.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum DetectorKind {
     /// The reference C AprilTag library (bundled, pinned source): the default.
@@ -49,14 +51,25 @@ pub enum DetectorKind {
 }
 
 /// Build a detector for `families` (single-threaded, as measured).
-pub fn make_detector(kind: DetectorKind, families: &[MarkerFamily]) -> Result<Box<dyn Detector>, DetectError> {
+pub fn make_detector(
+    kind: DetectorKind,
+    families: &[MarkerFamily],
+) -> Result<Box<dyn Detector>, DetectError> {
     Ok(match kind {
-        DetectorKind::ApriltagC => Box::new(super::apriltag::AprilTagC::new(families, &Default::default())?),
+        DetectorKind::ApriltagC => Box::new(super::apriltag::AprilTagC::new(
+            families,
+            &Default::default(),
+        )?),
         #[cfg(feature = "kornia")]
-        DetectorKind::Kornia => Box::new(super::kornia::KorniaDetector::new(families, &Default::default())?),
+        DetectorKind::Kornia => Box::new(super::kornia::KorniaDetector::new(
+            families,
+            &Default::default(),
+        )?),
         #[cfg(not(feature = "kornia"))]
         DetectorKind::Kornia => {
-            return Err(DetectError::Failed("this pushbot was built without the `kornia` feature".into()));
+            return Err(DetectError::Failed(
+                "this pushbot was built without the `kornia` feature".into(),
+            ));
         }
     })
 }

@@ -18,8 +18,9 @@ pub struct FolderSource {
 impl FolderSource {
     /// List the images in `dir`; an empty or missing folder is an error.
     pub fn open(dir: &Path, fps: f64) -> Result<FolderSource, SourceError> {
-        let entries = std::fs::read_dir(dir)
-            .map_err(|e| SourceError::BadSource(format!("cannot read image folder {}: {e}", dir.display())))?;
+        let entries = std::fs::read_dir(dir).map_err(|e| {
+            SourceError::BadSource(format!("cannot read image folder {}: {e}", dir.display()))
+        })?;
         let mut files: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| {
@@ -31,12 +32,22 @@ impl FolderSource {
             .collect();
         files.sort();
         if files.is_empty() {
-            return Err(SourceError::BadSource(format!("image folder {} has no .png or .jpg files", dir.display())));
+            return Err(SourceError::BadSource(format!(
+                "image folder {} has no .png or .jpg files",
+                dir.display()
+            )));
         }
         if !(fps > 0.0 && fps.is_finite()) {
-            return Err(SourceError::BadSource(format!("frame rate {fps} must be positive")));
+            return Err(SourceError::BadSource(format!(
+                "frame rate {fps} must be positive"
+            )));
         }
-        Ok(FolderSource { dir: dir.to_path_buf(), files, next: 0, fps })
+        Ok(FolderSource {
+            dir: dir.to_path_buf(),
+            files,
+            next: 0,
+            fps,
+        })
     }
 }
 
@@ -47,14 +58,21 @@ struct Sidecar {
 
 impl FrameSource for FolderSource {
     fn describe(&self) -> String {
-        format!("folder {} ({} images)", self.dir.display(), self.files.len())
+        format!(
+            "folder {} ({} images)",
+            self.dir.display(),
+            self.files.len()
+        )
     }
 
     fn next_frame(&mut self) -> Result<Option<Frame>, SourceError> {
-        let Some(path) = self.files.get(self.next).cloned() else { return Ok(None) };
+        let Some(path) = self.files.get(self.next).cloned() else {
+            return Ok(None);
+        };
         let index = self.next;
         self.next += 1;
-        let img = image::open(&path).map_err(|e| SourceError::Read(format!("{}: {e}", path.display())))?;
+        let img = image::open(&path)
+            .map_err(|e| SourceError::Read(format!("{}: {e}", path.display())))?;
         let gray = img.into_luma8();
         let (width, height) = gray.dimensions();
         let time = std::fs::read_to_string(path.with_extension("json"))
@@ -63,6 +81,12 @@ impl FrameSource for FolderSource {
             .map(|s| s.time)
             .filter(|t| t.is_finite())
             .unwrap_or(index as f64 / self.fps);
-        Ok(Some(Frame { seq: index as u64, time, width, height, pixels: gray.into_raw() }))
+        Ok(Some(Frame {
+            seq: index as u64,
+            time,
+            width,
+            height,
+            pixels: gray.into_raw(),
+        }))
     }
 }

@@ -30,7 +30,9 @@ pub struct KorniaDetector {
 
 impl std::fmt::Debug for KorniaDetector {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("KorniaDetector").field("families", &self.families).finish()
+        f.debug_struct("KorniaDetector")
+            .field("families", &self.families)
+            .finish()
     }
 }
 
@@ -43,7 +45,10 @@ fn kind(f: MarkerFamily) -> TagFamilyKind {
 
 impl KorniaDetector {
     /// A detector for these families.
-    pub fn new(families: &[MarkerFamily], cfg: &KorniaConfig) -> Result<KorniaDetector, DetectError> {
+    pub fn new(
+        families: &[MarkerFamily],
+        cfg: &KorniaConfig,
+    ) -> Result<KorniaDetector, DetectError> {
         let mut config = DecodeTagsConfig::new(families.iter().map(|&f| kind(f)).collect())
             .map_err(|e| DetectError::Failed(format!("{e}")))?;
         if let Some(t) = cfg.threshold_split {
@@ -56,7 +61,12 @@ impl KorniaDetector {
             .num_threads(1)
             .build()
             .map_err(|e| DetectError::Failed(format!("thread pool: {e}")))?;
-        Ok(KorniaDetector { config, decoder: None, pool, families: families.to_vec() })
+        Ok(KorniaDetector {
+            config,
+            decoder: None,
+            pool,
+            families: families.to_vec(),
+        })
     }
 }
 
@@ -66,17 +76,29 @@ impl Detector for KorniaDetector {
     }
 
     fn detect(&mut self, frame: &Frame) -> Result<Vec<Detection>, DetectError> {
-        let size = ImageSize { width: frame.width as usize, height: frame.height as usize };
+        let size = ImageSize {
+            width: frame.width as usize,
+            height: frame.height as usize,
+        };
         if frame.pixels.len() != size.width * size.height {
-            return Err(DetectError::Failed("frame buffer does not match its size".into()));
+            return Err(DetectError::Failed(
+                "frame buffer does not match its size".into(),
+            ));
         }
         if self.decoder.as_ref().is_none_or(|(_, s)| *s != size) {
-            let d = AprilTagDecoder::new(self.config.clone(), size).map_err(|e| DetectError::Failed(format!("{e}")))?;
+            let d = AprilTagDecoder::new(self.config.clone(), size)
+                .map_err(|e| DetectError::Failed(format!("{e}")))?;
             self.decoder = Some((d, size));
         }
-        let Some((decoder, _)) = self.decoder.as_mut() else { return Err(DetectError::Failed("no decoder".into())) };
-        let image = Image::new(size, frame.pixels.clone()).map_err(|e| DetectError::Failed(format!("{e}")))?;
-        let found = self.pool.install(|| decoder.decode(&image)).map_err(|e| DetectError::Failed(format!("{e}")))?;
+        let Some((decoder, _)) = self.decoder.as_mut() else {
+            return Err(DetectError::Failed("no decoder".into()));
+        };
+        let image = Image::new(size, frame.pixels.clone())
+            .map_err(|e| DetectError::Failed(format!("{e}")))?;
+        let found = self
+            .pool
+            .install(|| decoder.decode(&image))
+            .map_err(|e| DetectError::Failed(format!("{e}")))?;
         let mut out = Vec::with_capacity(found.len());
         for d in found {
             let family = match d.tag_family_kind {

@@ -38,14 +38,22 @@ impl Pose {
     /// The inverse transform.
     pub fn inverse(&self) -> Pose {
         let (s, c) = self.theta.sin_cos();
-        Pose { x: -(c * self.x + s * self.y), y: s * self.x - c * self.y, theta: wrap_angle(-self.theta) }
+        Pose {
+            x: -(c * self.x + s * self.y),
+            y: s * self.x - c * self.y,
+            theta: wrap_angle(-self.theta),
+        }
     }
 }
 
 /// An angle mapped into (−π, π].
 pub fn wrap_angle(a: f64) -> f64 {
     let t = a.rem_euclid(std::f64::consts::TAU);
-    if t > std::f64::consts::PI { t - std::f64::consts::TAU } else { t }
+    if t > std::f64::consts::PI {
+        t - std::f64::consts::TAU
+    } else {
+        t
+    }
 }
 
 /// A marker fixed on the table at a known place: used to calibrate the camera.
@@ -68,7 +76,13 @@ pub struct FixedMarker {
 impl FixedMarker {
     /// As a placement to render or to take corners from.
     pub fn placement(&self) -> MarkerPlacement {
-        MarkerPlacement { id: self.id, family: self.family, centre: self.centre, heading: self.heading, side: self.side }
+        MarkerPlacement {
+            id: self.id,
+            family: self.family,
+            centre: self.centre,
+            heading: self.heading,
+            side: self.side,
+        }
     }
 }
 
@@ -98,7 +112,13 @@ impl BodyMarker {
     /// Where the marker is when the body is at `body`.
     pub fn placement(&self, body: &Pose) -> MarkerPlacement {
         let m = body.compose(&self.offset_pose());
-        MarkerPlacement { id: self.id, family: self.family, centre: [m.x, m.y], heading: m.theta, side: self.side }
+        MarkerPlacement {
+            id: self.id,
+            family: self.family,
+            centre: [m.x, m.y],
+            heading: m.theta,
+            side: self.side,
+        }
     }
 
     /// The body's pose given its marker's pose.
@@ -126,7 +146,13 @@ impl MarkerLayout {
     /// 12, markers off their centres) and a goal (id 20). Markers are 5 × 5 cm as in Lau et al.
     pub fn default_table() -> MarkerLayout {
         let side = 0.05;
-        let fixed = |id, x, y| FixedMarker { id, family: MarkerFamily::Tag36h11, centre: [x, y], heading: 0.0, side };
+        let fixed = |id, x, y| FixedMarker {
+            id,
+            family: MarkerFamily::Tag36h11,
+            centre: [x, y],
+            heading: 0.0,
+            side,
+        };
         let body = |name: &str, id, offset: [f64; 3]| BodyMarker {
             body: name.into(),
             id,
@@ -155,13 +181,16 @@ impl MarkerLayout {
 
     /// Read a layout from a TOML or JSON file (by extension; TOML otherwise) and check it.
     pub fn load(path: &Path) -> Result<MarkerLayout, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
         let layout: MarkerLayout = if path.extension().is_some_and(|e| e == "json") {
             serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?
         } else {
             toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?
         };
-        layout.validate().map_err(|e| format!("{}: {e}", path.display()))?;
+        layout
+            .validate()
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(layout)
     }
 
@@ -171,11 +200,24 @@ impl MarkerLayout {
             return Err(format!("table size {:?} must be positive", self.table));
         }
         let mut seen = std::collections::HashSet::new();
-        let fixed = self.calibration.iter().map(|m| (m.family, m.id, m.side, m.centre[0] + m.centre[1] + m.heading));
-        let bodies = self.bodies.iter().map(|b| (b.family, b.id, b.side, b.offset.iter().sum::<f64>()));
+        let fixed = self.calibration.iter().map(|m| {
+            (
+                m.family,
+                m.id,
+                m.side,
+                m.centre[0] + m.centre[1] + m.heading,
+            )
+        });
+        let bodies = self
+            .bodies
+            .iter()
+            .map(|b| (b.family, b.id, b.side, b.offset.iter().sum::<f64>()));
         for (family, id, side, sum) in fixed.chain(bodies) {
             if !(side.is_finite() && side > 0.0) || !sum.is_finite() {
-                return Err(format!("marker {} {id}: side and positions must be finite, side positive", family.name()));
+                return Err(format!(
+                    "marker {} {id}: side and positions must be finite, side positive",
+                    family.name()
+                ));
             }
             if !seen.insert((family, id)) {
                 return Err(format!("marker {} {id} is used twice", family.name()));
@@ -186,18 +228,26 @@ impl MarkerLayout {
 
     /// The body marker with this tag, if any.
     pub fn body_marker(&self, family: MarkerFamily, id: u32) -> Option<&BodyMarker> {
-        self.bodies.iter().find(|b| b.family == family && b.id == id)
+        self.bodies
+            .iter()
+            .find(|b| b.family == family && b.id == id)
     }
 
     /// The calibration marker with this tag, if any.
     pub fn fixed_marker(&self, family: MarkerFamily, id: u32) -> Option<&FixedMarker> {
-        self.calibration.iter().find(|b| b.family == family && b.id == id)
+        self.calibration
+            .iter()
+            .find(|b| b.family == family && b.id == id)
     }
 
     /// The families any marker uses.
     pub fn families(&self) -> Vec<MarkerFamily> {
-        let mut f: Vec<MarkerFamily> =
-            self.calibration.iter().map(|m| m.family).chain(self.bodies.iter().map(|b| b.family)).collect();
+        let mut f: Vec<MarkerFamily> = self
+            .calibration
+            .iter()
+            .map(|m| m.family)
+            .chain(self.bodies.iter().map(|b| b.family))
+            .collect();
         f.sort_by_key(|f| f.name());
         f.dedup();
         if f.is_empty() {
@@ -213,7 +263,13 @@ mod tests {
 
     #[test]
     fn body_pose_inverts_placement() {
-        let b = BodyMarker { body: "o".into(), id: 1, family: MarkerFamily::Tag36h11, side: 0.05, offset: [0.03, -0.02, 0.7] };
+        let b = BodyMarker {
+            body: "o".into(),
+            id: 1,
+            family: MarkerFamily::Tag36h11,
+            side: 0.05,
+            offset: [0.03, -0.02, 0.7],
+        };
         let body = Pose::new(0.4, 0.3, -2.9);
         let m = b.placement(&body);
         let back = b.body_pose(&Pose::new(m.centre[0], m.centre[1], m.heading));

@@ -56,12 +56,21 @@ pub const SIDE_TOLERANCE: f64 = 0.15;
 pub fn measure(dets: &[Detection], cal: &Calibration, layout: &MarkerLayout) -> Vec<Measurement> {
     let mut best: Vec<(f32, Measurement)> = Vec::new();
     for d in dets {
-        let Some(bm) = layout.body_marker(d.family, d.id) else { continue };
-        let Some((marker_pose, side)) = cal.marker_pose(d) else { continue };
+        let Some(bm) = layout.body_marker(d.family, d.id) else {
+            continue;
+        };
+        let Some((marker_pose, side)) = cal.marker_pose(d) else {
+            continue;
+        };
         if (side / bm.side - 1.0).abs() > SIDE_TOLERANCE {
             continue;
         }
-        let m = Measurement { body: bm.body.clone(), marker: d.id, marker_pose, body_pose: bm.body_pose(&marker_pose) };
+        let m = Measurement {
+            body: bm.body.clone(),
+            marker: d.id,
+            marker_pose,
+            body_pose: bm.body_pose(&marker_pose),
+        };
         match best.iter().position(|(_, b)| b.body == m.body) {
             Some(i) if best[i].0 < d.margin => best[i] = (d.margin, m),
             Some(_) => {}
@@ -96,14 +105,27 @@ pub struct Pipeline {
 
 impl std::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Pipeline").field("detector", &self.detector.name()).field("tracker", &self.tracker).finish()
+        f.debug_struct("Pipeline")
+            .field("detector", &self.detector.name())
+            .field("tracker", &self.tracker)
+            .finish()
     }
 }
 
 impl Pipeline {
     /// A pipeline from its parts.
-    pub fn new(detector: Box<dyn Detector>, layout: MarkerLayout, calibration: Calibration, params: TrackerParams) -> Pipeline {
-        Pipeline { detector, layout, calibration, tracker: Tracker::new(params) }
+    pub fn new(
+        detector: Box<dyn Detector>,
+        layout: MarkerLayout,
+        calibration: Calibration,
+        params: TrackerParams,
+    ) -> Pipeline {
+        Pipeline {
+            detector,
+            layout,
+            calibration,
+            tracker: Tracker::new(params),
+        }
     }
 
     /// The calibration in use.
@@ -115,9 +137,18 @@ impl Pipeline {
     pub fn process(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
         let detections = self.detector.detect(frame)?;
         let measurements = measure(&detections, &self.calibration, &self.layout);
-        let obs: Vec<(String, Pose)> = measurements.iter().map(|m| (m.body.clone(), m.body_pose)).collect();
+        let obs: Vec<(String, Pose)> = measurements
+            .iter()
+            .map(|m| (m.body.clone(), m.body_pose))
+            .collect();
         let tracked = self.tracker.update(frame.time, &obs);
-        Ok(FrameResult { seq: frame.seq, time: frame.time, detections, measurements, tracked })
+        Ok(FrameResult {
+            seq: frame.seq,
+            time: frame.time,
+            detections,
+            measurements,
+            tracked,
+        })
     }
 }
 
@@ -157,7 +188,14 @@ impl From<&FrameResult> for TrackLine {
             bodies: r
                 .tracked
                 .iter()
-                .map(|t| TrackBody { id: t.body.clone(), x: t.pose.x, y: t.pose.y, theta: t.pose.theta, seen: t.seen && !t.rejected, age: t.age })
+                .map(|t| TrackBody {
+                    id: t.body.clone(),
+                    x: t.pose.x,
+                    y: t.pose.y,
+                    theta: t.pose.theta,
+                    seen: t.seen && !t.rejected,
+                    age: t.age,
+                })
                 .collect(),
         }
     }

@@ -23,9 +23,14 @@ pub struct SimSocketSource {
 impl SimSocketSource {
     /// Connect to the sim camera at `addr` (`HOST:PORT`).
     pub fn connect(addr: &str) -> Result<SimSocketSource, SourceError> {
-        let stream = TcpStream::connect(addr)
-            .map_err(|e| SourceError::BadSource(format!("cannot connect to the sim camera at {addr}: {e}")))?;
-        Ok(SimSocketSource { addr: addr.to_string(), reader: BufReader::new(stream), last_truth: Vec::new() })
+        let stream = TcpStream::connect(addr).map_err(|e| {
+            SourceError::BadSource(format!("cannot connect to the sim camera at {addr}: {e}"))
+        })?;
+        Ok(SimSocketSource {
+            addr: addr.to_string(),
+            reader: BufReader::new(stream),
+            last_truth: Vec::new(),
+        })
     }
 }
 
@@ -43,20 +48,33 @@ impl FrameSource for SimSocketSource {
         if n == 0 {
             return Ok(None);
         }
-        let h: FrameHeader = serde_json::from_str(line.trim_end())
-            .map_err(|e| SourceError::Read(format!("sim camera {}: bad frame header: {e}", self.addr)))?;
+        let h: FrameHeader = serde_json::from_str(line.trim_end()).map_err(|e| {
+            SourceError::Read(format!("sim camera {}: bad frame header: {e}", self.addr))
+        })?;
         if h.format != "gray8" {
-            return Err(SourceError::Read(format!("sim camera {}: unknown pixel format {:?}", self.addr, h.format)));
+            return Err(SourceError::Read(format!(
+                "sim camera {}: unknown pixel format {:?}",
+                self.addr, h.format
+            )));
         }
         let count = h.width as u64 * h.height as u64;
         if count == 0 || count > MAX_PIXELS || !h.time.is_finite() {
-            return Err(SourceError::Read(format!("sim camera {}: bad frame size {}x{}", self.addr, h.width, h.height)));
+            return Err(SourceError::Read(format!(
+                "sim camera {}: bad frame size {}x{}",
+                self.addr, h.width, h.height
+            )));
         }
         let mut pixels = vec![0u8; count as usize];
-        self.reader
-            .read_exact(&mut pixels)
-            .map_err(|e| SourceError::Read(format!("sim camera {}: frame cut short: {e}", self.addr)))?;
+        self.reader.read_exact(&mut pixels).map_err(|e| {
+            SourceError::Read(format!("sim camera {}: frame cut short: {e}", self.addr))
+        })?;
         self.last_truth = h.truth;
-        Ok(Some(Frame { seq: h.seq, time: h.time, width: h.width, height: h.height, pixels }))
+        Ok(Some(Frame {
+            seq: h.seq,
+            time: h.time,
+            width: h.width,
+            height: h.height,
+            pixels,
+        }))
     }
 }

@@ -46,14 +46,23 @@ pub trait FrameSource {
 
 /// Open a source from its `--camera` spelling.
 pub fn open_source(spec: &str, fps: f64) -> Result<Box<dyn FrameSource>, SourceError> {
-    if let Some(addr) = spec.strip_prefix("sim:").or_else(|| spec.strip_prefix("tcp:")) {
+    if let Some(addr) = spec
+        .strip_prefix("sim:")
+        .or_else(|| spec.strip_prefix("tcp:"))
+    {
         return Ok(Box::new(super::simsocket::SimSocketSource::connect(addr)?));
     }
     if let Some(dev) = spec.strip_prefix("v4l2:") {
-        return Ok(Box::new(super::v4l2::V4l2Source::open(Path::new(dev), Default::default())?));
+        return Ok(Box::new(super::v4l2::V4l2Source::open(
+            Path::new(dev),
+            Default::default(),
+        )?));
     }
     if spec.starts_with("/dev/video") {
-        return Ok(Box::new(super::v4l2::V4l2Source::open(Path::new(spec), Default::default())?));
+        return Ok(Box::new(super::v4l2::V4l2Source::open(
+            Path::new(spec),
+            Default::default(),
+        )?));
     }
     let path = Path::new(spec);
     if path.is_dir() {

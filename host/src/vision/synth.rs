@@ -39,23 +39,31 @@ pub struct SynthParams {
 
 impl Default for SynthParams {
     fn default() -> Self {
-        SynthParams { size: [960, 720], tilt: [1.0e-5, -0.7e-5], blur: [0.5, 1.0], noise: [2.0, 4.0], exposure: [0.85, 1.1] }
+        SynthParams {
+            size: [960, 720],
+            tilt: [1.0e-5, -0.7e-5],
+            blur: [0.5, 1.0],
+            noise: [2.0, 4.0],
+            exposure: [0.85, 1.1],
+        }
     }
 }
 
 fn body_polygon(name: &str, pose: &Pose) -> Polygon {
     let local: Vec<[f64; 2]> = if name == "robot" {
-        (0..24).map(|k| {
-            let a = k as f64 * std::f64::consts::TAU / 24.0;
-            [0.07 * a.cos(), 0.07 * a.sin()]
-        })
-        .collect()
+        (0..24)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 24.0;
+                [0.07 * a.cos(), 0.07 * a.sin()]
+            })
+            .collect()
     } else if name == "goal" {
-        (0..24).map(|k| {
-            let a = k as f64 * std::f64::consts::TAU / 24.0;
-            [0.05 * a.cos(), 0.05 * a.sin()]
-        })
-        .collect()
+        (0..24)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 24.0;
+                [0.05 * a.cos(), 0.05 * a.sin()]
+            })
+            .collect()
     } else {
         vec![[-0.07, -0.05], [0.07, -0.05], [0.07, 0.05], [-0.07, 0.05]]
     };
@@ -76,9 +84,15 @@ fn body_polygon(name: &str, pose: &Pose) -> Polygon {
 
 /// `n` frames of the layout: calibration markers where they belong, bodies at random poses
 /// (one per region of the table, so they do not overlap), 1/30 s apart.
-pub fn frames(layout: &MarkerLayout, n: usize, seed: u64, params: &SynthParams) -> Result<Vec<SynthFrame>, String> {
+pub fn frames(
+    layout: &MarkerLayout,
+    n: usize,
+    seed: u64,
+    params: &SynthParams,
+) -> Result<Vec<SynthFrame>, String> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let model = CameraModel::overhead(layout.table, params.size[0], params.size[1], 16.0).tilted(params.tilt[0], params.tilt[1]);
+    let model = CameraModel::overhead(layout.table, params.size[0], params.size[1], 16.0)
+        .tilted(params.tilt[0], params.tilt[1]);
     let mut config = CameraConfig::default_for_table(layout.table);
     config.model = model;
     let mut camera = Camera::new(config, seed ^ 0x5eed).map_err(|e| e.to_string())?;
@@ -88,7 +102,13 @@ pub fn frames(layout: &MarkerLayout, n: usize, seed: u64, params: &SynthParams) 
     let rows = nb.div_ceil(cols);
     let mut out = Vec::with_capacity(n);
     for k in 0..n {
-        let range = |r: [f64; 2], rng: &mut ChaCha8Rng| if r[1] > r[0] { rng.random_range(r[0]..r[1]) } else { r[0] };
+        let range = |r: [f64; 2], rng: &mut ChaCha8Rng| {
+            if r[1] > r[0] {
+                rng.random_range(r[0]..r[1])
+            } else {
+                r[0]
+            }
+        };
         let imaging = Imaging {
             blur_sigma_px: range(params.blur, &mut rng),
             noise_sigma: range(params.noise, &mut rng),
@@ -115,9 +135,21 @@ pub fn frames(layout: &MarkerLayout, n: usize, seed: u64, params: &SynthParams) 
             bodies.push((b.body.clone(), pose));
         }
         let time = k as f64 / 30.0;
-        let cf = camera.capture(time, &polys, &markers).map_err(|e| e.to_string())?;
-        let frame = Frame { seq: k as u64, time, width: cf.width, height: cf.height, pixels: cf.pixels };
-        out.push(SynthFrame { frame, markers: cf.truth, bodies });
+        let cf = camera
+            .capture(time, &polys, &markers)
+            .map_err(|e| e.to_string())?;
+        let frame = Frame {
+            seq: k as u64,
+            time,
+            width: cf.width,
+            height: cf.height,
+            pixels: cf.pixels,
+        };
+        out.push(SynthFrame {
+            frame,
+            markers: cf.truth,
+            bodies,
+        });
     }
     Ok(out)
 }
@@ -153,7 +185,10 @@ impl DetectionScore {
                 for (c, tc) in d.corners.iter().zip(&t.corners_px) {
                     let e = [c[0] - tc[0], c[1] - tc[1]];
                     let n = self.corner_errors.len() as f64;
-                    self.corner_bias = [(self.corner_bias[0] * n + e[0]) / (n + 1.0), (self.corner_bias[1] * n + e[1]) / (n + 1.0)];
+                    self.corner_bias = [
+                        (self.corner_bias[0] * n + e[0]) / (n + 1.0),
+                        (self.corner_bias[1] * n + e[1]) / (n + 1.0),
+                    ];
                     self.corner_errors.push(e[0].hypot(e[1]));
                 }
             }
@@ -172,7 +207,11 @@ impl DetectionScore {
 
     /// Fraction of visible markers found.
     pub fn rate(&self) -> f64 {
-        if self.visible == 0 { 1.0 } else { self.found as f64 / self.visible as f64 }
+        if self.visible == 0 {
+            1.0
+        } else {
+            self.found as f64 / self.visible as f64
+        }
     }
 
     /// Root-mean-square corner error, pixels.
@@ -199,8 +238,13 @@ impl PoseScore {
         for (name, pose) in truth {
             match measured.iter().find(|m| &m.body == name) {
                 Some(m) => {
-                    self.pos_mm.push(1000.0 * (m.body_pose.x - pose.x).hypot(m.body_pose.y - pose.y));
-                    self.heading_deg.push(wrap_angle(m.body_pose.theta - pose.theta).abs().to_degrees());
+                    self.pos_mm
+                        .push(1000.0 * (m.body_pose.x - pose.x).hypot(m.body_pose.y - pose.y));
+                    self.heading_deg.push(
+                        wrap_angle(m.body_pose.theta - pose.theta)
+                            .abs()
+                            .to_degrees(),
+                    );
                 }
                 None => self.missed += 1,
             }
@@ -220,6 +264,10 @@ pub fn quantile(values: &[f64], q: f64) -> f64 {
 }
 
 /// Calibrate from the first `k` frames' detections.
-pub fn calibrate(dets: &[Vec<Detection>], layout: &MarkerLayout, size: [u32; 2]) -> Result<Calibration, String> {
+pub fn calibrate(
+    dets: &[Vec<Detection>],
+    layout: &MarkerLayout,
+    size: [u32; 2],
+) -> Result<Calibration, String> {
     Calibration::fit(dets, layout, size).map_err(|e| e.to_string())
 }

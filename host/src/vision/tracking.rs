@@ -8,7 +8,9 @@
 
 use std::collections::BTreeMap;
 
-use adskalman::{CovarianceUpdateMethod, ObservationModel, StateAndCovariance, TransitionModelLinearNoControl};
+use adskalman::{
+    CovarianceUpdateMethod, ObservationModel, StateAndCovariance, TransitionModelLinearNoControl,
+};
 use nalgebra::{SMatrix, SVector, U3, U6};
 use serde::{Deserialize, Serialize};
 
@@ -38,7 +40,14 @@ pub struct TrackerParams {
 
 impl Default for TrackerParams {
     fn default() -> Self {
-        TrackerParams { pos_sigma: 0.0008, heading_sigma: 0.006, accel_sigma: 1.0, ang_accel_sigma: 10.0, gate: 16.27, restart_after: 4 }
+        TrackerParams {
+            pos_sigma: 0.0008,
+            heading_sigma: 0.006,
+            accel_sigma: 1.0,
+            ang_accel_sigma: 10.0,
+            gate: 16.27,
+            restart_after: 4,
+        }
     }
 }
 
@@ -55,14 +64,22 @@ impl Motion {
             f[(i, i + 3)] = dt;
         }
         let mut q = M6::zeros();
-        for (i, s) in [(0, p.accel_sigma), (1, p.accel_sigma), (2, p.ang_accel_sigma)] {
+        for (i, s) in [
+            (0, p.accel_sigma),
+            (1, p.accel_sigma),
+            (2, p.ang_accel_sigma),
+        ] {
             let s2 = s * s;
             q[(i, i)] = s2 * dt.powi(4) / 4.0;
             q[(i, i + 3)] = s2 * dt.powi(3) / 2.0;
             q[(i + 3, i)] = s2 * dt.powi(3) / 2.0;
             q[(i + 3, i + 3)] = s2 * dt * dt;
         }
-        Motion { f, ft: f.transpose(), q }
+        Motion {
+            f,
+            ft: f.transpose(),
+            q,
+        }
     }
 }
 
@@ -90,8 +107,16 @@ impl Observe {
         for i in 0..3 {
             h[(i, i)] = 1.0;
         }
-        let r = M3::from_diagonal(&SVector::<f64, 3>::new(p.pos_sigma.powi(2), p.pos_sigma.powi(2), p.heading_sigma.powi(2)));
-        Observe { h, ht: h.transpose(), r }
+        let r = M3::from_diagonal(&SVector::<f64, 3>::new(
+            p.pos_sigma.powi(2),
+            p.pos_sigma.powi(2),
+            p.heading_sigma.powi(2),
+        ));
+        Observe {
+            h,
+            ht: h.transpose(),
+            r,
+        }
     }
 }
 
@@ -140,14 +165,21 @@ pub struct Tracker {
 
 impl std::fmt::Debug for Tracker {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Tracker").field("params", &self.params).field("bodies", &self.tracks.keys().collect::<Vec<_>>()).finish()
+        f.debug_struct("Tracker")
+            .field("params", &self.params)
+            .field("bodies", &self.tracks.keys().collect::<Vec<_>>())
+            .finish()
     }
 }
 
 impl Tracker {
     /// A tracker with these settings.
     pub fn new(params: TrackerParams) -> Tracker {
-        Tracker { observe: Observe::new(&params), params, tracks: BTreeMap::new() }
+        Tracker {
+            observe: Observe::new(&params),
+            params,
+            tracks: BTreeMap::new(),
+        }
     }
 
     fn start(&self, z: &Pose, time: f64) -> Track {
@@ -161,7 +193,12 @@ impl Tracker {
             0.25,
             4.0,
         ));
-        Track { est: StateAndCovariance::new(x, cov), time, last_seen: time, rejected_run: 0 }
+        Track {
+            est: StateAndCovariance::new(x, cov),
+            time,
+            last_seen: time,
+            rejected_run: 0,
+        }
     }
 
     /// Advance every track to `time` and fold in this frame's observations (body name, measured
@@ -172,7 +209,12 @@ impl Tracker {
             seen.insert(name, pose);
         }
         let mut out = Vec::new();
-        let names: Vec<String> = self.tracks.keys().cloned().chain(seen.keys().map(|s| s.to_string())).collect();
+        let names: Vec<String> = self
+            .tracks
+            .keys()
+            .cloned()
+            .chain(seen.keys().map(|s| s.to_string()))
+            .collect();
         let mut done = std::collections::BTreeSet::new();
         for name in names {
             if !done.insert(name.clone()) {
@@ -187,7 +229,10 @@ impl Tracker {
                     let dt = (time - t.time).max(0.0);
                     let prior = Motion::new(dt, &self.params).predict(&t.est);
                     // Keep the covariance exactly symmetric (the library checks it).
-                    let prior = StateAndCovariance::new(*prior.state(), prior.covariance().symmetric_part());
+                    let prior = StateAndCovariance::new(
+                        *prior.state(),
+                        prior.covariance().symmetric_part(),
+                    );
                     t.time = time;
                     t.est = prior;
                     if let Some(z) = obs {
@@ -225,7 +270,11 @@ impl Tracker {
     }
 
     /// The posterior, or `None` if the observation fails the gate.
-    fn correct(&self, prior: &StateAndCovariance<f64, U6>, z: &Pose) -> Option<StateAndCovariance<f64, U6>> {
+    fn correct(
+        &self,
+        prior: &StateAndCovariance<f64, U6>,
+        z: &Pose,
+    ) -> Option<StateAndCovariance<f64, U6>> {
         let x = prior.state();
         let zt = x[2] + wrap_angle(z.theta - x[2]);
         let zv = SVector::<f64, 3>::new(z.x, z.y, zt);
@@ -235,7 +284,10 @@ impl Tracker {
         if d2.is_nan() || d2 > self.params.gate {
             return None;
         }
-        let post = self.observe.update(prior, &zv, CovarianceUpdateMethod::JosephForm).ok()?;
+        let post = self
+            .observe
+            .update(prior, &zv, CovarianceUpdateMethod::JosephForm)
+            .ok()?;
         let mut st = *post.state();
         st[2] = wrap_angle(st[2]);
         Some(StateAndCovariance::new(st, *post.covariance()))
@@ -256,7 +308,13 @@ mod tests {
         let pos = Normal::new(0.0, 0.0008).unwrap();
         let ang = Normal::new(0.0, 0.006).unwrap();
         let mut tracker = Tracker::new(TrackerParams::default());
-        let truth = |t: f64| Pose::new(0.6 + 0.2 * (0.5 * t).cos(), 0.45 + 0.2 * (0.5 * t).sin(), wrap_angle(3.0 + 0.8 * t));
+        let truth = |t: f64| {
+            Pose::new(
+                0.6 + 0.2 * (0.5 * t).cos(),
+                0.45 + 0.2 * (0.5 * t).sin(),
+                wrap_angle(3.0 + 0.8 * t),
+            )
+        };
         let (mut raw_err, mut filt_err, mut n) = (0.0, 0.0, 0);
         let mut rejected = 0;
         for k in 0..300 {
@@ -265,7 +323,11 @@ mod tests {
             let mut obs = vec![];
             let outlier = k % 37 == 20;
             if k % 10 != 3 {
-                let mut z = Pose::new(g.x + pos.sample(&mut rng), g.y + pos.sample(&mut rng), wrap_angle(g.theta + ang.sample(&mut rng)));
+                let mut z = Pose::new(
+                    g.x + pos.sample(&mut rng),
+                    g.y + pos.sample(&mut rng),
+                    wrap_angle(g.theta + ang.sample(&mut rng)),
+                );
                 if outlier {
                     z.x += 0.15;
                     z.theta += 1.0;
@@ -289,14 +351,22 @@ mod tests {
             }
             let e = (p.pose.x - g.x).hypot(p.pose.y - g.y);
             assert!(e < 0.005, "frame {k}: error {e}");
-            assert!(wrap_angle(p.pose.theta - g.theta).abs() < 0.03, "frame {k}: heading");
+            assert!(
+                wrap_angle(p.pose.theta - g.theta).abs() < 0.03,
+                "frame {k}: heading"
+            );
             if k > 30 && k % 10 != 3 && !outlier {
                 filt_err += e;
                 n += 1;
             }
         }
         assert!(rejected >= 7);
-        assert!(filt_err < raw_err, "filter {:.5} vs raw {:.5} over {n}", filt_err / n as f64, raw_err / n as f64);
+        assert!(
+            filt_err < raw_err,
+            "filter {:.5} vs raw {:.5} over {n}",
+            filt_err / n as f64,
+            raw_err / n as f64
+        );
     }
 
     /// A body that really jumps is picked up again after a few rejected frames.

@@ -27,7 +27,11 @@ pub struct V4l2Request {
 
 impl Default for V4l2Request {
     fn default() -> Self {
-        V4l2Request { width: 960, height: 720, fps: 30 }
+        V4l2Request {
+            width: 960,
+            height: 720,
+            fps: 30,
+        }
     }
 }
 
@@ -60,10 +64,14 @@ impl V4l2Source {
                 path.display()
             )));
         }
-        let bad = |what: &str, e: std::io::Error| SourceError::BadSource(format!("camera device {}: {what}: {e}", path.display()));
+        let bad = |what: &str, e: std::io::Error| {
+            SourceError::BadSource(format!("camera device {}: {what}: {e}", path.display()))
+        };
         let device = Device::open(path).map_err(|e| bad("cannot open it as a V4L2 device", e))?;
-        let formats: Vec<PixelFormat> =
-            device.formats(BufType::VIDEO_CAPTURE).filter_map(|f| f.ok().map(|f| f.pixel_format())).collect();
+        let formats: Vec<PixelFormat> = device
+            .formats(BufType::VIDEO_CAPTURE)
+            .filter_map(|f| f.ok().map(|f| f.pixel_format()))
+            .collect();
         let format = [PixelFormat::MJPG, PixelFormat::YUYV, GREY]
             .into_iter()
             .find(|f| formats.contains(f))
@@ -78,11 +86,21 @@ impl V4l2Source {
             .map_err(|e| bad("cannot start video capture", e))?;
         let _ = capture.set_frame_interval(linuxvideo::Fract::new(1, req.fps.max(1)));
         let got = capture.format();
-        let (width, height, bytes_per_line, format) = (got.width(), got.height(), got.bytes_per_line(), got.pixel_format());
+        let (width, height, bytes_per_line, format) = (
+            got.width(),
+            got.height(),
+            got.bytes_per_line(),
+            got.pixel_format(),
+        );
         if width == 0 || height == 0 {
-            return Err(SourceError::BadSource(format!("camera device {} negotiated an empty frame", path.display())));
+            return Err(SourceError::BadSource(format!(
+                "camera device {} negotiated an empty frame",
+                path.display()
+            )));
         }
-        let stream = capture.into_stream().map_err(|e| bad("cannot start streaming", e))?;
+        let stream = capture
+            .into_stream()
+            .map_err(|e| bad("cannot start streaming", e))?;
         Ok(V4l2Source {
             path: path.to_path_buf(),
             stream,
@@ -98,11 +116,22 @@ impl V4l2Source {
 
 impl FrameSource for V4l2Source {
     fn describe(&self) -> String {
-        format!("v4l2 {} {}x{} {}", self.path.display(), self.width, self.height, self.format)
+        format!(
+            "v4l2 {} {}x{} {}",
+            self.path.display(),
+            self.width,
+            self.height,
+            self.format
+        )
     }
 
     fn next_frame(&mut self) -> Result<Option<Frame>, SourceError> {
-        let (w, h, bpl, fmt) = (self.width as usize, self.height as usize, self.bytes_per_line as usize, self.format);
+        let (w, h, bpl, fmt) = (
+            self.width as usize,
+            self.height as usize,
+            self.bytes_per_line as usize,
+            self.format,
+        );
         let pixels = self
             .stream
             .dequeue(|buf| {
@@ -114,18 +143,33 @@ impl FrameSource for V4l2Source {
         let time = self.start.elapsed().as_secs_f64();
         let seq = self.seq;
         self.seq += 1;
-        Ok(Some(Frame { seq, time, width: self.width, height: self.height, pixels }))
+        Ok(Some(Frame {
+            seq,
+            time,
+            width: self.width,
+            height: self.height,
+            pixels,
+        }))
     }
 }
 
 /// Luminance of one captured buffer.
-fn to_gray(data: &[u8], w: usize, h: usize, bpl: usize, fmt: PixelFormat) -> Result<Vec<u8>, String> {
+fn to_gray(
+    data: &[u8],
+    w: usize,
+    h: usize,
+    bpl: usize,
+    fmt: PixelFormat,
+) -> Result<Vec<u8>, String> {
     if fmt == PixelFormat::MJPG {
         let img = image::load_from_memory_with_format(data, image::ImageFormat::Jpeg)
             .map_err(|e| format!("bad MJPEG frame: {e}"))?
             .into_luma8();
         if img.dimensions() != (w as u32, h as u32) {
-            return Err(format!("MJPEG frame is {:?}, expected {w}x{h}", img.dimensions()));
+            return Err(format!(
+                "MJPEG frame is {:?}, expected {w}x{h}",
+                img.dimensions()
+            ));
         }
         return Ok(img.into_raw());
     }
@@ -149,7 +193,10 @@ mod tests {
     #[test]
     fn yuyv_keeps_luma() {
         let data = [10, 128, 20, 128, 30, 128, 40, 128];
-        assert_eq!(to_gray(&data, 2, 2, 4, PixelFormat::YUYV).unwrap(), vec![10, 20, 30, 40]);
+        assert_eq!(
+            to_gray(&data, 2, 2, 4, PixelFormat::YUYV).unwrap(),
+            vec![10, 20, 30, 40]
+        );
         assert!(to_gray(&data[..5], 2, 2, 4, PixelFormat::YUYV).is_err());
     }
 }

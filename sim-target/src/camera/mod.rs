@@ -34,7 +34,8 @@ impl CameraModel {
     /// A camera straight above the centre of a `table[0] × table[1]` m table, the table filling
     /// the image but for `margin_px` on its tighter side; table +y is image up.
     pub fn overhead(table: [f64; 2], width: u32, height: u32, margin_px: f64) -> CameraModel {
-        let s = ((width as f64 - 2.0 * margin_px) / table[0]).min((height as f64 - 2.0 * margin_px) / table[1]);
+        let s = ((width as f64 - 2.0 * margin_px) / table[0])
+            .min((height as f64 - 2.0 * margin_px) / table[1]);
         let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
         CameraModel {
             width,
@@ -54,7 +55,10 @@ impl CameraModel {
         let t = Homography([[1.0, 0.0, cx], [0.0, 1.0, cy], [0.0, 0.0, 1.0]]);
         let t_inv = Homography([[1.0, 0.0, -cx], [0.0, 1.0, -cy], [0.0, 0.0, 1.0]]);
         let p = Homography([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [px, py, 1.0]]);
-        CameraModel { table_to_pixel: t.compose(&p).compose(&t_inv).compose(&self.table_to_pixel), ..self }
+        CameraModel {
+            table_to_pixel: t.compose(&p).compose(&t_inv).compose(&self.table_to_pixel),
+            ..self
+        }
     }
 }
 
@@ -175,8 +179,11 @@ impl CameraFrame {
         std::fs::create_dir_all(dir)?;
         let png = dir.join(format!("frame-{:06}.png", self.seq));
         let img = image::GrayImage::from_raw(self.width, self.height, self.pixels.clone())
-            .ok_or_else(|| CameraError::Invalid("pixel buffer size does not match the frame size".into()))?;
-        img.save(&png).map_err(|e| CameraError::Io(std::io::Error::other(e)))?;
+            .ok_or_else(|| {
+                CameraError::Invalid("pixel buffer size does not match the frame size".into())
+            })?;
+        img.save(&png)
+            .map_err(|e| CameraError::Io(std::io::Error::other(e)))?;
         let json = serde_json::to_string(self).map_err(|e| CameraError::Invalid(e.to_string()))?;
         std::fs::write(dir.join(format!("frame-{:06}.json", self.seq)), json)?;
         Ok(png)
@@ -196,12 +203,24 @@ impl Camera {
     /// A camera with its own noise stream from `seed`.
     pub fn new(config: CameraConfig, seed: u64) -> Result<Camera, CameraError> {
         if config.model.table_to_pixel.inverse().is_none() {
-            return Err(CameraError::Invalid("table→pixel homography is singular".into()));
+            return Err(CameraError::Invalid(
+                "table→pixel homography is singular".into(),
+            ));
         }
-        if !(config.fps.is_finite() && config.fps > 0.0) || config.model.width == 0 || config.model.height == 0 {
-            return Err(CameraError::Invalid("frame rate and image size must be positive".into()));
+        if !(config.fps.is_finite() && config.fps > 0.0)
+            || config.model.width == 0
+            || config.model.height == 0
+        {
+            return Err(CameraError::Invalid(
+                "frame rate and image size must be positive".into(),
+            ));
         }
-        Ok(Camera { config, codes: TagCodes::new().map_err(CameraError::Invalid)?, rng: ChaCha8Rng::seed_from_u64(seed), seq: 0 })
+        Ok(Camera {
+            config,
+            codes: TagCodes::new().map_err(CameraError::Invalid)?,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            seq: 0,
+        })
     }
 
     /// The configuration.
@@ -215,7 +234,12 @@ impl Camera {
     }
 
     /// Render the next frame at simulated `time`: table, `polygons` in order, then `markers`.
-    pub fn capture(&mut self, time: f64, polygons: &[Polygon], markers: &[MarkerPlacement]) -> Result<CameraFrame, CameraError> {
+    pub fn capture(
+        &mut self,
+        time: f64,
+        polygons: &[Polygon],
+        markers: &[MarkerPlacement],
+    ) -> Result<CameraFrame, CameraError> {
         let cfg = &self.config;
         let im = &cfg.imaging;
         let (w, h) = (cfg.model.width as usize, cfg.model.height as usize);
@@ -224,27 +248,57 @@ impl Camera {
             .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
         let n = im.supersample.max(1);
         let [tw, th] = cfg.table;
-        let table = Polygon { points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]], shade: im.table_shade };
+        let table = Polygon {
+            points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]],
+            shade: im.table_shade,
+        };
         canvas.polygon(&table, n);
         for p in polygons {
             canvas.polygon(p, n);
         }
         let mut truth = Vec::with_capacity(markers.len());
         for m in markers {
-            canvas.marker(&self.codes, m, im.quiet_cells, n, im.ink[0], im.ink[1]).map_err(CameraError::Invalid)?;
+            canvas
+                .marker(&self.codes, m, im.quiet_cells, n, im.ink[0], im.ink[1])
+                .map_err(CameraError::Invalid)?;
             let px = |p: [f64; 2]| h_tp.apply(p).unwrap_or([f64::NAN; 2]);
-            let (_, tw, wab) = self.codes.pattern(m.family, m.id).ok_or_else(|| CameraError::Invalid("bad id".into()))?;
+            let (_, tw, wab) = self
+                .codes
+                .pattern(m.family, m.id)
+                .ok_or_else(|| CameraError::Invalid("bad id".into()))?;
             let outer_side = m.side * (tw as f64 + 2.0 * im.quiet_cells) / wab as f64;
-            let outer = MarkerPlacement { side: outer_side, ..*m };
+            let outer = MarkerPlacement {
+                side: outer_side,
+                ..*m
+            };
             let fully_visible = outer.corners().iter().all(|&p| {
                 let q = px(p);
                 q[0] >= 1.0 && q[1] >= 1.0 && q[0] <= w as f64 - 1.0 && q[1] <= h as f64 - 1.0
             });
-            truth.push(MarkerTruth { marker: *m, corners_px: m.corners().map(px), centre_px: px(m.centre), fully_visible });
+            truth.push(MarkerTruth {
+                marker: *m,
+                corners_px: m.corners().map(px),
+                centre_px: px(m.centre),
+                fully_visible,
+            });
         }
         render::gaussian_blur(&mut canvas.data, w, h, im.blur_sigma_px);
-        let pixels = render::develop(&canvas.data, im.exposure, im.black_level, im.white_level, im.noise_sigma, &mut self.rng);
-        let frame = CameraFrame { seq: self.seq, time, width: cfg.model.width, height: cfg.model.height, pixels, truth };
+        let pixels = render::develop(
+            &canvas.data,
+            im.exposure,
+            im.black_level,
+            im.white_level,
+            im.noise_sigma,
+            &mut self.rng,
+        );
+        let frame = CameraFrame {
+            seq: self.seq,
+            time,
+            width: cfg.model.width,
+            height: cfg.model.height,
+            pixels,
+            truth,
+        };
         self.seq += 1;
         Ok(frame)
     }
@@ -259,19 +313,40 @@ mod tests {
         let m = CameraModel::overhead([1.2, 0.9], 960, 720, 16.0);
         let a = m.table_to_pixel.apply([0.0, 0.9]).unwrap();
         let b = m.table_to_pixel.apply([1.2, 0.0]).unwrap();
-        assert!(a[0] >= 15.9 && a[1] >= 15.9 && b[0] <= 944.1 && b[1] <= 704.1, "{a:?} {b:?}");
+        assert!(
+            a[0] >= 15.9 && a[1] >= 15.9 && b[0] <= 944.1 && b[1] <= 704.1,
+            "{a:?} {b:?}"
+        );
         let t = m.tilted(1e-5, -1e-5);
         let c = t.table_to_pixel.apply([0.6, 0.45]).unwrap();
-        assert!((c[0] - 480.0).abs() < 1e-9 && (c[1] - 360.0).abs() < 1e-9, "centre stays: {c:?}");
+        assert!(
+            (c[0] - 480.0).abs() < 1e-9 && (c[1] - 360.0).abs() < 1e-9,
+            "centre stays: {c:?}"
+        );
     }
 
     #[test]
     fn frames_are_seeded_and_carry_truth() {
         let cfg = CameraConfig::default_for_table([1.2, 0.9]);
-        let m = MarkerPlacement { id: 7, family: MarkerFamily::Tag36h11, centre: [0.6, 0.45], heading: 0.3, side: 0.05 };
-        let a = Camera::new(cfg, 5).unwrap().capture(0.0, &[], &[m]).unwrap();
-        let b = Camera::new(cfg, 5).unwrap().capture(0.0, &[], &[m]).unwrap();
-        let c = Camera::new(cfg, 6).unwrap().capture(0.0, &[], &[m]).unwrap();
+        let m = MarkerPlacement {
+            id: 7,
+            family: MarkerFamily::Tag36h11,
+            centre: [0.6, 0.45],
+            heading: 0.3,
+            side: 0.05,
+        };
+        let a = Camera::new(cfg, 5)
+            .unwrap()
+            .capture(0.0, &[], &[m])
+            .unwrap();
+        let b = Camera::new(cfg, 5)
+            .unwrap()
+            .capture(0.0, &[], &[m])
+            .unwrap();
+        let c = Camera::new(cfg, 6)
+            .unwrap()
+            .capture(0.0, &[], &[m])
+            .unwrap();
         assert_eq!(a.pixels, b.pixels);
         assert_ne!(a.pixels, c.pixels);
         assert_eq!(a.pixels.len(), 960 * 720);
@@ -281,8 +356,17 @@ mod tests {
         // The pixel at the tag's centre-left black ring is dark, the table is mid-gray.
         let g = |x: f64, y: f64| a.pixels[y as usize * 960 + x as usize];
         assert!(g(10.0, 360.0) < 80, "floor dark");
-        assert!((100..160).contains(&g(300.0, 360.0)), "table mid-gray: {}", g(300.0, 360.0));
+        assert!(
+            (100..160).contains(&g(300.0, 360.0)),
+            "table mid-gray: {}",
+            g(300.0, 360.0)
+        );
         let bad = MarkerPlacement { id: 900, ..m };
-        assert!(Camera::new(cfg, 5).unwrap().capture(0.0, &[], &[bad]).is_err());
+        assert!(
+            Camera::new(cfg, 5)
+                .unwrap()
+                .capture(0.0, &[], &[bad])
+                .is_err()
+        );
     }
 }

@@ -16,7 +16,8 @@ pub struct Homography(pub [[f64; 3]; 3]);
 
 impl Homography {
     /// The identity map.
-    pub const IDENTITY: Homography = Homography([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    pub const IDENTITY: Homography =
+        Homography([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
 
     /// Map a point; `None` when it maps to infinity (or behind the camera).
     pub fn apply(&self, p: [f64; 2]) -> Option<[f64; 2]> {
@@ -45,15 +46,29 @@ impl Homography {
     /// The inverse map, `None` if singular.
     pub fn inverse(&self) -> Option<Homography> {
         let m = &self.0;
-        let c = |r0: usize, r1: usize, c0: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
+        let c = |r0: usize, r1: usize, c0: usize, c1: usize| {
+            m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+        };
         let det = m[0][0] * c(1, 2, 1, 2) - m[0][1] * c(1, 2, 0, 2) + m[0][2] * c(1, 2, 0, 1);
         if det.abs() < 1e-300 || !det.is_finite() {
             return None;
         }
         let inv = [
-            [c(1, 2, 1, 2) / det, -c(0, 2, 1, 2) / det, c(0, 1, 1, 2) / det],
-            [-c(1, 2, 0, 2) / det, c(0, 2, 0, 2) / det, -c(0, 1, 0, 2) / det],
-            [c(1, 2, 0, 1) / det, -c(0, 2, 0, 1) / det, c(0, 1, 0, 1) / det],
+            [
+                c(1, 2, 1, 2) / det,
+                -c(0, 2, 1, 2) / det,
+                c(0, 1, 1, 2) / det,
+            ],
+            [
+                -c(1, 2, 0, 2) / det,
+                c(0, 2, 0, 2) / det,
+                -c(0, 1, 0, 2) / det,
+            ],
+            [
+                c(1, 2, 0, 1) / det,
+                -c(0, 2, 0, 1) / det,
+                c(0, 1, 0, 1) / det,
+            ],
         ];
         Some(Homography(inv))
     }
@@ -103,8 +118,12 @@ impl MarkerPlacement {
     pub fn corners(&self) -> [[f64; 2]; 4] {
         let h = self.side / 2.0;
         let (s, c) = self.heading.sin_cos();
-        [[-h, -h], [h, -h], [h, h], [-h, h]]
-            .map(|[a, b]| [self.centre[0] + c * a - s * b, self.centre[1] + s * a + c * b])
+        [[-h, -h], [h, -h], [h, h], [-h, h]].map(|[a, b]| {
+            [
+                self.centre[0] + c * a - s * b,
+                self.centre[1] + s * a + c * b,
+            ]
+        })
     }
 }
 
@@ -188,7 +207,12 @@ pub struct Canvas {
 
 impl Canvas {
     /// A canvas of uniform reflectance `fill` seen through `table_to_pixel`.
-    pub fn new(width: usize, height: usize, table_to_pixel: Homography, fill: f64) -> Option<Canvas> {
+    pub fn new(
+        width: usize,
+        height: usize,
+        table_to_pixel: Homography,
+        fill: f64,
+    ) -> Option<Canvas> {
         Some(Canvas {
             width,
             height,
@@ -218,7 +242,12 @@ impl Canvas {
 
     /// Cover the pixels in the box with `shade(p)` where it returns a value, averaging `n × n`
     /// samples per pixel; samples where `shade` returns `None` keep the pixel's current value.
-    fn paint(&mut self, bbox: (usize, usize, usize, usize), n: usize, shade: impl Fn([f64; 2]) -> Option<f32>) {
+    fn paint(
+        &mut self,
+        bbox: (usize, usize, usize, usize),
+        n: usize,
+        shade: impl Fn([f64; 2]) -> Option<f32>,
+    ) {
         let (x0, y0, x1, y1) = bbox;
         let inv = 1.0 / n as f64;
         let h = self.pixel_to_table.0;
@@ -232,7 +261,10 @@ impl Canvas {
                     for i in 0..n {
                         let u = x as f64 + (i as f64 + 0.5) * inv;
                         let w = h[2][0] * u + h[2][1] * v + h[2][2];
-                        let p = [(h[0][0] * u + h[0][1] * v + h[0][2]) / w, (h[1][0] * u + h[1][1] * v + h[1][2]) / w];
+                        let p = [
+                            (h[0][0] * u + h[0][1] * v + h[0][2]) / w,
+                            (h[1][0] * u + h[1][1] * v + h[1][2]) / w,
+                        ];
                         match shade(p) {
                             Some(s) => {
                                 sum += s;
@@ -256,10 +288,17 @@ impl Canvas {
         if poly.points.len() < 3 {
             return;
         }
-        let Some(px) = poly.points.iter().map(|p| self.table_to_pixel.apply(*p)).collect::<Option<Vec<_>>>() else {
+        let Some(px) = poly
+            .points
+            .iter()
+            .map(|p| self.table_to_pixel.apply(*p))
+            .collect::<Option<Vec<_>>>()
+        else {
             return;
         };
-        let Some((x0, y0, x1, y1)) = self.bbox(&poly.points) else { return };
+        let Some((x0, y0, x1, y1)) = self.bbox(&poly.points) else {
+            return;
+        };
         let n = n.max(1);
         let shade = poly.shade as f32;
         let mut cov = vec![0.0f64; x1 - x0];
@@ -323,8 +362,13 @@ impl Canvas {
         }
         let cell = m.side / wab as f64;
         let half = (tw as f64 / 2.0 + quiet_cells) * cell;
-        let outer = MarkerPlacement { side: 2.0 * half, ..*m };
-        let Some(bbox) = self.bbox(&outer.corners()) else { return Ok(()) };
+        let outer = MarkerPlacement {
+            side: 2.0 * half,
+            ..*m
+        };
+        let Some(bbox) = self.bbox(&outer.corners()) else {
+            return Ok(());
+        };
         let (s, c) = m.heading.sin_cos();
         let (b, w) = (black as f32, white as f32);
         let twf = tw as f64;
@@ -340,7 +384,11 @@ impl Canvas {
             if col < 0.0 || row < 0.0 || col >= twf || row >= twf {
                 return Some(w);
             }
-            Some(if pattern[row as usize * tw + col as usize] { w } else { b })
+            Some(if pattern[row as usize * tw + col as usize] {
+                w
+            } else {
+                b
+            })
         });
         Ok(())
     }
@@ -352,7 +400,9 @@ pub fn point_in_polygon(pts: &[[f64; 2]], p: [f64; 2]) -> bool {
     let mut j = pts.len() - 1;
     for i in 0..pts.len() {
         let (a, b) = (pts[i], pts[j]);
-        if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0] {
+        if (a[1] > p[1]) != (b[1] > p[1])
+            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+        {
             inside = !inside;
         }
         j = i;
@@ -366,7 +416,9 @@ pub fn gaussian_blur(data: &mut [f32], width: usize, height: usize, sigma: f64) 
         return;
     }
     let r = (3.0 * sigma).ceil() as isize;
-    let mut k: Vec<f32> = (-r..=r).map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32).collect();
+    let mut k: Vec<f32> = (-r..=r)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
+        .collect();
     let sum: f32 = k.iter().sum();
     k.iter_mut().for_each(|v| *v /= sum);
     let mut tmp = vec![0.0f32; data.len()];
@@ -424,7 +476,11 @@ mod tests {
 
     #[test]
     fn homography_inverse_round_trips() {
-        let h = Homography([[700.0, 3.0, 20.0], [-2.0, -690.0, 700.0], [1e-4, -2e-4, 1.0]]);
+        let h = Homography([
+            [700.0, 3.0, 20.0],
+            [-2.0, -690.0, 700.0],
+            [1e-4, -2e-4, 1.0],
+        ]);
         let inv = h.inverse().unwrap();
         for p in [[0.1, 0.2], [1.1, 0.85], [0.6, 0.0]] {
             let q = inv.apply(h.apply(p).unwrap()).unwrap();
@@ -440,10 +496,16 @@ mod tests {
         let (p, tw, wab) = codes.pattern(MarkerFamily::Tag36h11, 0).unwrap();
         assert_eq!((tw, wab), (10, 8));
         for i in 0..tw {
-            assert!(p[i] && p[(tw - 1) * tw + i] && p[i * tw] && p[i * tw + tw - 1], "white border");
+            assert!(
+                p[i] && p[(tw - 1) * tw + i] && p[i * tw] && p[i * tw + tw - 1],
+                "white border"
+            );
         }
         for i in 1..tw - 1 {
-            assert!(!p[tw + i] && !p[(tw - 2) * tw + i] && !p[i * tw + 1] && !p[i * tw + tw - 2], "black ring");
+            assert!(
+                !p[tw + i] && !p[(tw - 2) * tw + i] && !p[i * tw + 1] && !p[i * tw + tw - 2],
+                "black ring"
+            );
         }
         // Bits read back in the family's order give the code.
         let fam = &TAG36H11;
@@ -461,7 +523,10 @@ mod tests {
     #[test]
     fn edge_coverage_is_subpixel_exact() {
         let mut c = Canvas::new(8, 4, Homography::IDENTITY, 0.0).unwrap();
-        let poly = Polygon { points: vec![[0.0, 0.0], [3.25, 0.0], [3.25, 4.0], [0.0, 4.0]], shade: 1.0 };
+        let poly = Polygon {
+            points: vec![[0.0, 0.0], [3.25, 0.0], [3.25, 4.0], [0.0, 4.0]],
+            shade: 1.0,
+        };
         c.polygon(&poly, 8);
         assert_eq!(c.data[2], 1.0);
         assert!((c.data[3] - 0.25).abs() < 1e-6, "{}", c.data[3]);

@@ -51,17 +51,19 @@ impl CameraServer {
         let addr = listener.local_addr()?;
         let clients = Arc::new(Mutex::new(Vec::new()));
         let accepted = Arc::clone(&clients);
-        std::thread::Builder::new().name("camera-accept".into()).spawn(move || {
-            for stream in listener.incoming() {
-                let Ok(stream) = stream else { continue };
-                let _ = stream.set_nodelay(true);
-                let _ = stream.set_write_timeout(Some(Duration::from_secs(2)));
-                match accepted.lock() {
-                    Ok(mut c) => c.push(stream),
-                    Err(_) => return,
+        std::thread::Builder::new()
+            .name("camera-accept".into())
+            .spawn(move || {
+                for stream in listener.incoming() {
+                    let Ok(stream) = stream else { continue };
+                    let _ = stream.set_nodelay(true);
+                    let _ = stream.set_write_timeout(Some(Duration::from_secs(2)));
+                    match accepted.lock() {
+                        Ok(mut c) => c.push(stream),
+                        Err(_) => return,
+                    }
                 }
-            }
-        })?;
+            })?;
         Ok(CameraServer { addr, clients })
     }
 
@@ -86,10 +88,19 @@ impl CameraServer {
             format: "gray8".into(),
             truth: frame.truth.clone(),
         };
-        let Ok(mut line) = serde_json::to_vec(&header) else { return 0 };
+        let Ok(mut line) = serde_json::to_vec(&header) else {
+            return 0;
+        };
         line.push(b'\n');
-        let Ok(mut clients) = self.clients.lock() else { return 0 };
-        clients.retain_mut(|c| c.write_all(&line).and_then(|_| c.write_all(&frame.pixels)).and_then(|_| c.flush()).is_ok());
+        let Ok(mut clients) = self.clients.lock() else {
+            return 0;
+        };
+        clients.retain_mut(|c| {
+            c.write_all(&line)
+                .and_then(|_| c.write_all(&frame.pixels))
+                .and_then(|_| c.flush())
+                .is_ok()
+        });
         clients.len()
     }
 }
@@ -109,13 +120,23 @@ mod tests {
             }
             std::thread::sleep(Duration::from_millis(5));
         }
-        let frame = CameraFrame { seq: 3, time: 0.1, width: 4, height: 2, pixels: (0..8).collect(), truth: vec![] };
+        let frame = CameraFrame {
+            seq: 3,
+            time: 0.1,
+            width: 4,
+            height: 2,
+            pixels: (0..8).collect(),
+            truth: vec![],
+        };
         assert_eq!(server.publish(&frame), 1);
         let mut r = BufReader::new(client);
         let mut line = String::new();
         r.read_line(&mut line).unwrap();
         let h: FrameHeader = serde_json::from_str(&line).unwrap();
-        assert_eq!((h.seq, h.width, h.height, h.format.as_str()), (3, 4, 2, "gray8"));
+        assert_eq!(
+            (h.seq, h.width, h.height, h.format.as_str()),
+            (3, 4, 2, "gray8")
+        );
         let mut px = vec![0u8; 8];
         r.read_exact(&mut px).unwrap();
         assert_eq!(px, frame.pixels);
