@@ -213,7 +213,7 @@ impl MarkerLayout {
             .iter()
             .map(|b| (b.family, b.id, b.side, b.offset.iter().sum::<f64>()));
         for (family, id, side, sum) in fixed.chain(bodies) {
-            if !(side.is_finite() && side > 0.0) || !sum.is_finite() {
+            if !(side.is_finite() && side > 0.0 && sum.is_finite()) {
                 return Err(format!(
                     "marker {} {id}: side and positions must be finite, side positive",
                     family.name()
