@@ -8,3 +8,4 @@ pub mod cli;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
+pub mod vision;

@@ -10,6 +10,7 @@ use clap::{Args, Parser, Subcommand};
 pub mod rearrange;
 pub mod robot;
 pub mod stable;
+pub mod vision;
 
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
@@ -45,6 +46,10 @@ pub enum Command {
     /// Plan a task without running it.
     #[command(subcommand)]
     Plan(PlanCommand),
+    /// Calibrate the overhead camera from markers at known table positions.
+    Calibrate(vision::CalibrateArgs),
+    /// Track the robot, objects and goals with the overhead camera (one line per frame).
+    Track(vision::TrackArgs),
     /// Measure planners and pipelines; prints numbers.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -66,6 +71,8 @@ pub enum BenchCommand {
     Rearrange(rearrange::BenchArgs),
     /// Plan time of the stable-pushing presets next to the paper's.
     Stable(stable::BenchStableArgs),
+    #[command(flatten)]
+    Vision(vision::BenchCommand),
 }
 
 /// How a command that ran to its end went.
@@ -142,5 +149,8 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Plan(PlanCommand::Stable(a)) => stable::run_plan(&global, &a),
         Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
         Command::Bench(BenchCommand::Stable(a)) => stable::run_bench(&global, &a),
+        Command::Calibrate(a) => vision::calibrate(&global, a),
+        Command::Track(a) => vision::track(&global, a),
+        Command::Bench(BenchCommand::Vision(b)) => vision::bench(&global, b),
     }
 }
