@@ -1,9 +1,12 @@
 //! pushbot host: the PC side of the pushing robot.
 //!
 //! Data flows one way: camera → `vision` → planners (`planner`, `strategy`) → motion
-//! primitives (`exec`) → `link` → firmware → motors. See `DESIGN.md` of the project.
+//! primitives → `link` → firmware → motors. See `DESIGN.md` of the project.
 #![forbid(unsafe_code)]
 
 pub mod cli;
 pub mod link;
+pub mod mechanics;
+pub mod planner;
 pub mod strategy;
+pub mod vision;

@@ -27,3 +27,5 @@ pub use robot::Pose;
 pub use scene::{Scene, SceneError};
 pub use sim::{Sim, SimOptions, Truth, TruthRecord};
 pub use world::{Body, Hardware, World};
+
+pub mod camera;

@@ -7,8 +7,11 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+pub mod rearrange;
 pub mod robot;
+pub mod stable;
 pub mod strategy;
+pub mod vision;
 
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
@@ -39,12 +42,44 @@ pub struct Cli {
 pub enum Command {
     /// Talk to the robot: info, move, spin, stop, estop, clear-faults.
     Robot(robot::RobotArgs),
+    /// Pushing mechanics of an object: STABLE per edge, controllability (Lynch & Mason §3).
+    Mechanics(stable::MechanicsArgs),
+    /// Plan a task without running it.
+    #[command(subcommand)]
+    Plan(PlanCommand),
     /// Collect a pushing strategy for an object (Lau et al. Algorithm 1), in simulation.
     Collect(strategy::CollectArgs),
     /// Evaluate: `eval delivery` (Lau et al. Fig. 11, learned vs dipole).
     Eval(strategy::EvalArgs),
-    /// Benchmarks: `bench knn`.
-    Bench(strategy::BenchArgs),
+    /// Calibrate the overhead camera from markers at known table positions.
+    Calibrate(vision::CalibrateArgs),
+    /// Track the robot, objects and goals with the overhead camera (one line per frame).
+    Track(vision::TrackArgs),
+    /// Measure planners and pipelines; prints numbers.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `pushbot plan …`.
+#[derive(Subcommand, Debug)]
+pub enum PlanCommand {
+    /// Rearrange movables by pushing, optimally (Ben-Shahar & Rivlin).
+    Rearrange(rearrange::PlanArgs),
+    /// Stable pushing among obstacles (Lynch & Mason §4).
+    Stable(stable::PlanStableArgs),
+}
+
+/// `pushbot bench …`.
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Cost-map building of the rearrangement planner on large rooms.
+    Rearrange(rearrange::BenchArgs),
+    /// Plan time of the stable-pushing presets next to the paper's.
+    Stable(stable::BenchStableArgs),
+    #[command(flatten)]
+    Vision(vision::BenchCommand),
+    #[command(flatten)]
+    Strategy(strategy::BenchCmd),
 }
 
 /// How a command that ran to its end went.
@@ -116,8 +151,18 @@ pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
     match command {
         Command::Robot(args) => robot::run(&global, args),
+        Command::Mechanics(a) => stable::run_mechanics(&global, &a),
+        Command::Plan(PlanCommand::Rearrange(args)) => rearrange::plan(&global, args),
+        Command::Plan(PlanCommand::Stable(a)) => stable::run_plan(&global, &a),
+        Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
+        Command::Bench(BenchCommand::Stable(a)) => stable::run_bench(&global, &a),
+        Command::Calibrate(a) => vision::calibrate(&global, a),
+        Command::Track(a) => vision::track(&global, a),
+        Command::Bench(BenchCommand::Vision(b)) => vision::bench(&global, b),
+        Command::Bench(BenchCommand::Strategy(cmd)) => {
+            strategy::run_bench(&global, strategy::BenchArgs { cmd })
+        }
         Command::Collect(args) => strategy::run_collect(&global, args),
         Command::Eval(args) => strategy::run_eval(&global, args),
-        Command::Bench(args) => strategy::run_bench(&global, args),
     }
 }

@@ -1,0 +1,245 @@
+//! `pushbot calibrate`, `pushbot track`, `pushbot bench vision`: the overhead camera's
+//! calibration, live tracking and speed.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand};
+
+use super::{CliError, CliResult, Global, Status};
+use crate::vision::calibration::Calibration;
+use crate::vision::detect::{DetectorKind, make_detector};
+use crate::vision::layout::MarkerLayout;
+use crate::vision::source::{FrameSource, SourceError, open_source};
+use crate::vision::tracking::TrackerParams;
+use crate::vision::{Pipeline, TrackLine, bench};
+
+/// Where frames come from and what is on the table.
+#[derive(Args, Debug, Clone)]
+pub struct CameraArgs {
+    /// Frame source: /dev/videoN (V4L2), sim:HOST:PORT (the sim camera), or a folder of images.
+    #[arg(long)]
+    pub camera: String,
+    /// Marker layout (TOML or JSON: table, calibration markers, body markers); default: the
+    /// built-in 1.2 × 0.9 m table.
+    #[arg(long)]
+    pub layout: Option<PathBuf>,
+    /// Frame rate assumed for image folders without time sidecars.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Marker detector.
+    #[arg(long, value_enum, default_value = "apriltag-c")]
+    pub detector: DetectorKind,
+}
+
+/// `pushbot calibrate`.
+#[derive(Args, Debug, Clone)]
+pub struct CalibrateArgs {
+    /// Source and layout.
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Frames to collect detections from.
+    #[arg(long, default_value_t = 5)]
+    pub frames: usize,
+    /// Where to save the calibration (JSON).
+    #[arg(long, default_value = "calibration.json")]
+    pub out: PathBuf,
+}
+
+/// `pushbot track`.
+#[derive(Args, Debug, Clone)]
+pub struct TrackArgs {
+    /// Source and layout.
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// A saved calibration; without one, the first frames showing four calibration markers
+    /// calibrate the camera.
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// Stop after this many frames (default: until the source ends).
+    #[arg(long)]
+    pub frames: Option<usize>,
+}
+
+/// `pushbot bench …`.
+#[derive(Subcommand, Debug, Clone)]
+pub enum BenchCommand {
+    /// Milliseconds per 960×720 frame: the chosen vision pipeline, the reference C detector and
+    /// the kornia candidate, on the same rendered frames, one core.
+    Vision {
+        /// Frames to render and measure.
+        #[arg(long, default_value_t = 100)]
+        frames: usize,
+    },
+}
+
+fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
+    match &args.layout {
+        Some(p) => MarkerLayout::load(p).map_err(CliError::bad_input),
+        None => Ok(MarkerLayout::default_table()),
+    }
+}
+
+fn source(args: &CameraArgs) -> Result<Box<dyn FrameSource>, CliError> {
+    open_source(&args.camera, args.fps).map_err(|e| match e {
+        SourceError::BadSource(m) => CliError::bad_input(m),
+        SourceError::Read(m) => CliError::Failed(anyhow::anyhow!(m)),
+    })
+}
+
+fn read_err(e: SourceError) -> CliError {
+    CliError::Failed(anyhow::anyhow!("{e}"))
+}
+
+/// Collect up to `n` frames' detections and fit a calibration (the inner error: the frames do
+/// not allow one, a failed task rather than bad input).
+fn calibrate_from(
+    src: &mut dyn FrameSource,
+    args: &CameraArgs,
+    lay: &MarkerLayout,
+    n: usize,
+) -> Result<Result<Calibration, String>, CliError> {
+    let mut det =
+        make_detector(args.detector, &lay.families()).map_err(|e| CliError::Failed(e.into()))?;
+    let mut all = Vec::new();
+    let mut size = [0, 0];
+    while all.len() < n.max(1) {
+        let Some(frame) = src.next_frame().map_err(read_err)? else {
+            break;
+        };
+        size = [frame.width, frame.height];
+        all.push(det.detect(&frame).map_err(|e| CliError::Failed(e.into()))?);
+    }
+    if all.is_empty() {
+        return Err(CliError::bad_input(format!(
+            "{} gave no frames to calibrate from",
+            src.describe()
+        )));
+    }
+    Ok(Calibration::fit(&all, lay, size).map_err(|e| e.to_string()))
+}
+
+/// `pushbot calibrate`.
+pub fn calibrate(g: &Global, args: CalibrateArgs) -> CliResult {
+    let lay = layout(&args.camera)?;
+    let mut src = source(&args.camera)?;
+    let cal = match calibrate_from(src.as_mut(), &args.camera, &lay, args.frames)? {
+        Ok(c) => c,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            return Ok(Status::TaskFailed);
+        }
+    };
+    cal.save(&args.out)
+        .map_err(|e| CliError::Failed(e.into()))?;
+    if g.json {
+        let v = serde_json::json!({"calibration": args.out, "rms_px": cal.rms_px, "max_px": cal.max_px,
+            "mm_per_px": cal.mm_per_px, "markers": cal.markers, "points": cal.points});
+        println!("{v}");
+    } else {
+        println!(
+            "calibrated from markers {:?} ({} points): reprojection RMS {:.3} px, max {:.3} px ({:.2} mm/px); saved {}",
+            cal.markers,
+            cal.points,
+            cal.rms_px,
+            cal.max_px,
+            cal.mm_per_px,
+            args.out.display()
+        );
+    }
+    Ok(Status::Success)
+}
+
+/// `pushbot track`.
+pub fn track(g: &Global, args: TrackArgs) -> CliResult {
+    let lay = layout(&args.camera)?;
+    let mut src = source(&args.camera)?;
+    let cal = match &args.calibration {
+        Some(p) => Calibration::load(p).map_err(CliError::bad_input)?,
+        None => match calibrate_from(src.as_mut(), &args.camera, &lay, 1)? {
+            Ok(c) => c,
+            Err(msg) => {
+                eprintln!("error: {msg}");
+                return Ok(Status::TaskFailed);
+            }
+        },
+    };
+    let det = make_detector(args.camera.detector, &lay.families())
+        .map_err(|e| CliError::Failed(e.into()))?;
+    let mut pipe = Pipeline::new(det, lay, cal, TrackerParams::default());
+    let mut out = std::io::stdout().lock();
+    let mut count = 0;
+    while args.frames.is_none_or(|n| count < n) {
+        let Some(frame) = src.next_frame().map_err(read_err)? else {
+            break;
+        };
+        let r = pipe
+            .process(&frame)
+            .map_err(|e| CliError::Failed(e.into()))?;
+        let line = TrackLine::from(&r);
+        let text = if g.json {
+            serde_json::to_string(&line).map_err(|e| CliError::Failed(e.into()))?
+        } else {
+            let bodies: Vec<String> = line
+                .bodies
+                .iter()
+                .map(|b| {
+                    format!(
+                        "{} ({:.4}, {:.4}, {:.1}°){}",
+                        b.id,
+                        b.x,
+                        b.y,
+                        b.theta.to_degrees(),
+                        if b.seen { "" } else { " unseen" }
+                    )
+                })
+                .collect();
+            format!("t={:.3}s {}", line.time, bodies.join("  "))
+        };
+        if writeln!(out, "{text}").is_err() {
+            break;
+        }
+        count += 1;
+    }
+    Ok(Status::Success)
+}
+
+/// `pushbot bench vision`.
+pub fn bench(g: &Global, cmd: BenchCommand) -> CliResult {
+    match cmd {
+        BenchCommand::Vision { frames } => {
+            let r = bench::run(frames, g.seed).map_err(|e| CliError::Failed(anyhow::anyhow!(e)))?;
+            if g.json {
+                println!(
+                    "{}",
+                    serde_json::to_string(&r).map_err(|e| CliError::Failed(e.into()))?
+                );
+            } else {
+                println!("{} frames {}x{}, one core", r.frames, r.size[0], r.size[1]);
+                println!(
+                    "pipeline ({}): {:.2} ms/frame mean, {:.2} median; position error median {:.3} mm, p99 {:.3} mm; heading median {:.3}°",
+                    r.pipeline,
+                    r.pipeline_ms_mean,
+                    r.pipeline_ms_median,
+                    r.position_mm[0],
+                    r.position_mm[1],
+                    r.heading_deg[0]
+                );
+                for d in &r.detectors {
+                    println!(
+                        "  {:<40} {:7.2} ms/frame (median {:.2})  found {:.2}%  wrong ids {}  corner RMS {:.3} px  bias ({:+.3}, {:+.3})",
+                        d.name,
+                        d.ms_mean,
+                        d.ms_median,
+                        100.0 * d.detection_rate,
+                        d.wrong_ids,
+                        d.corner_rms_px,
+                        d.corner_bias_px[0],
+                        d.corner_bias_px[1]
+                    );
+                }
+            }
+            Ok(Status::Success)
+        }
+    }
+}

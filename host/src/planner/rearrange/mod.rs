@@ -1,0 +1,79 @@
+//! Rearrangement planning of several movables by pushing: Ben-Shahar & Rivlin, "To Push or Not
+//! to Push" (§II problem, §IV algorithm, §V test cases).
+//!
+//! - [`problem`]: the pushing problem of §II-A on a grid, composite configurations packed into
+//!   integer indices;
+//! - [`admissibility`]: admissible neighbours and origins, §IV-B, computed on the fly;
+//! - [`metric`]: the cost metrics of §IV-C (mass, safety, passability, contact-mode changes, turns);
+//! - [`costmap`]: the cost mapping phase, §IV-A1 (backward propagation from a goal set);
+//! - [`restore`]: the pushing C-path restoration phase, §IV-A2;
+//! - [`cases`]: the scene format and the test cases A–D of §V-A;
+//! - [`svg`]: plans drawn as the paper's step-by-step figures.
+//!
+//! Limits (§IV-E): the map holds one `u16` per packed configuration, so memory grows as
+//! (free cells)^(1 + r) — 128 MB for the robot and 2 boxes in a 20 × 20 room, 860 MB for 3 boxes in
+//! 12 × 12, and a 4th box or a 3-DOF movable multiplies it again by the cells (and by 4). Time is
+//! bounded by cache misses on that array: the wave front is scattered, so buckets are sorted by
+//! index before they are expanded. Plan costs must stay below 65 535.
+
+pub mod admissibility;
+pub mod cases;
+pub mod costmap;
+pub mod metric;
+pub mod problem;
+pub mod restore;
+pub mod svg;
+
+pub use admissibility::{MoveKind, Step};
+pub use costmap::{CostMap, INF, MapError, MapStats, cost_map};
+pub use metric::Metric;
+pub use problem::{
+    Config, ContactMode, Dir, Grid, Model, MovableSpec, Placement, Problem, RobotSpec, Rules,
+};
+pub use restore::{Plan, RestoreError, restore};
+
+/// Map the problem's goal set and restore the plan from its start: (model, map, plan or why not).
+pub fn solve(
+    problem: &Problem,
+) -> Result<(Model, CostMap, Result<Plan, RestoreError>), SolveError> {
+    let model = Model::new(problem)?;
+    let map = cost_map(&model)?;
+    let start = model.pack(&problem.start).ok_or(SolveError::StartNotFree)?;
+    let plan = restore(&model, &map, start);
+    Ok((model, map, plan))
+}
+
+/// Why a problem could not be mapped.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SolveError {
+    /// The description is wrong.
+    #[error(transparent)]
+    Problem(#[from] problem::ProblemError),
+    /// The map overflowed.
+    #[error(transparent)]
+    Map(#[from] MapError),
+    /// The start overlaps something.
+    #[error("the start configuration is not free")]
+    StartNotFree,
+}
+
+/// Cost of following a sequence of configurations under a model's admissibility and metric:
+/// `None` if some step is not an admissible move there. Used to compare plans across presets.
+pub fn replay_cost(model: &Model, start: &Config, configs: &[Config]) -> Option<u32> {
+    let mut cur = model.pack(start)?;
+    let mut total = 0;
+    let mut nb = Vec::new();
+    for c in configs {
+        model.neighbours(cur, &mut nb);
+        let best = nb
+            .iter()
+            .filter(|s| {
+                let u = model.unpack(s.to);
+                u.robot == c.robot && u.movables == c.movables
+            })
+            .min_by_key(|s| s.cost)?;
+        total += best.cost;
+        cur = best.to;
+    }
+    Some(total)
+}

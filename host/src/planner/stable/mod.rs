@@ -1,0 +1,298 @@
+//! Planning stable pushing paths among obstacles: Lynch & Mason (1996) §4.
+//!
+//! A best-first search (§4.1) over slider configurations whose controls are the extremal stable
+//! pushing directions of each pushing contact (STABLE, §3.3.1, intersected with what the pusher
+//! can do, Fig. 14), integer costs `a·steps + b·control changes + c·contact changes` (§4.2.2)
+//! kept in a bucketed OPEN list, pruning on a configuration grid per contact (§4.2.3), a goal
+//! neighbourhood, MAXCOST and a node limit (§4.2.4). Beyond the paper: exact collision of
+//! pusher + slider along every step ([`collision`]), transit paths for a mobile pusher between
+//! contacts (§4.6's open problem, [`transit`]), and the exact-goal variant of §4.5.
+
+pub mod collision;
+pub mod presets;
+pub mod pusher;
+pub mod search;
+pub mod svg;
+pub mod transit;
+
+use std::f64::consts::PI;
+
+use crate::mechanics::stable::stable;
+use crate::mechanics::{MechanicsError, Slider, V2, V3};
+use collision::{Body, World};
+use pusher::{Placement, Pusher, Usable};
+
+pub use search::{Plan, Queue, plan, plan_with};
+
+/// A slider configuration `(x, y, θ)` in the world frame.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Pose {
+    /// x of the centre of friction (m).
+    pub x: f64,
+    /// y of the centre of friction (m).
+    pub y: f64,
+    /// Orientation (rad).
+    pub theta: f64,
+}
+
+impl Pose {
+    /// A pose.
+    pub fn new(x: f64, y: f64, theta: f64) -> Self {
+        Pose { x, y, theta }
+    }
+
+    /// A slider-frame point in the world frame.
+    pub fn apply(&self, p: V2) -> V2 {
+        let (s, c) = self.theta.sin_cos();
+        V2::new(self.x + c * p.x - s * p.y, self.y + s * p.x + c * p.y)
+    }
+
+    /// A slider-frame vector in the world frame.
+    pub fn rotate(&self, v: V2) -> V2 {
+        let (s, c) = self.theta.sin_cos();
+        V2::new(c * v.x - s * v.y, s * v.x + c * v.y)
+    }
+
+    /// The pose reached by following the slider-frame twist `xi` for unit time
+    /// (`q ∘ exp(ξ)`: a rotation about the fixed centre `COR(ξ)`, or a translation).
+    pub fn integrate(&self, xi: &V3) -> Pose {
+        match cor_of(xi) {
+            Some(c) => {
+                let phi = xi.z;
+                let (s, co) = phi.sin_cos();
+                let rc = V2::new(co * c.x - s * c.y, s * c.x + co * c.y);
+                let d = self.rotate(c - rc);
+                Pose::new(self.x + d.x, self.y + d.y, self.theta + phi)
+            }
+            None => {
+                let d = self.rotate(V2::new(xi.x, xi.y));
+                Pose::new(self.x + d.x, self.y + d.y, self.theta)
+            }
+        }
+    }
+
+    /// The slider-frame twist `ξ` with `self.integrate(ξ) == other` and `|ω| ≤ π`: the single
+    /// constant push between the two poses.
+    pub fn twist_to(&self, other: &Pose) -> V3 {
+        let (s, c) = self.theta.sin_cos();
+        let (dx, dy) = (other.x - self.x, other.y - self.y);
+        let d = V2::new(c * dx + s * dy, -s * dx + c * dy);
+        let phi = angle_diff(other.theta, self.theta);
+        if phi.abs() < 1e-12 {
+            return V3::new(d.x, d.y, 0.0);
+        }
+        let (sp, cp) = phi.sin_cos();
+        let det = 2.0 - 2.0 * cp;
+        let cx = ((1.0 - cp) * d.x - sp * d.y) / det;
+        let cy = (sp * d.x + (1.0 - cp) * d.y) / det;
+        V3::new(phi * cy, -phi * cx, phi)
+    }
+}
+
+/// The rotation centre of a twist (slider frame), `None` for a translation.
+pub fn cor_of(xi: &V3) -> Option<V2> {
+    crate::mechanics::cor(xi)
+}
+
+/// `a − b` wrapped into `(−π, π]`.
+pub fn angle_diff(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(2.0 * PI);
+    if d > PI { d - 2.0 * PI } else { d }
+}
+
+/// Planner parameters (§4.2.2–4.2.4).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Params {
+    /// Cost per push step.
+    pub a: u32,
+    /// Cost per control change.
+    pub b: u32,
+    /// Cost per contact change; `None` = ∞ (contact changes disallowed).
+    pub c: Option<u32>,
+    /// Step length: the largest distance a slider vertex moves in one step (m).
+    pub step: f64,
+    /// Pruning grid cell size in x and y (m).
+    pub grid_xy: f64,
+    /// Pruning grid cell size in θ (rad).
+    pub grid_theta: f64,
+    /// Half-width of the goal neighbourhood in x and y (m).
+    pub goal_xy: f64,
+    /// Half-width of the goal neighbourhood in θ (rad).
+    pub goal_theta: f64,
+    /// MAXCOST.
+    pub max_cost: u32,
+    /// Node limit: configurations expanded before giving up.
+    pub max_nodes: usize,
+    /// Within this distance of the goal position, step and grid are refined (§4.5); 0 = off.
+    pub fine_radius: f64,
+    /// Refinement factor (≥ 1) for step and grid cells near the goal.
+    pub fine_factor: f64,
+}
+
+/// One pushing contact the planner may use: an edge, the pusher placed on it, its usable pushes
+/// and the body `PS` (slider + pusher) it moves.
+#[derive(Debug, Clone)]
+pub struct ContactModel {
+    /// Slider edge index.
+    pub edge: usize,
+    /// The pusher's placement on the edge.
+    pub placement: Placement,
+    /// Stable ∩ pusher-feasible pushes.
+    pub usable: Usable,
+    /// Slider + pusher footprint, slider frame.
+    pub body: Body,
+    /// Pusher footprint in the slider frame (empty for negligible pushers).
+    pub footprint: Vec<V2>,
+    /// Step twists: control `k` scaled to one step.
+    pub steps: Vec<V3>,
+    /// Step twists near the goal (refined step, §4.5).
+    pub fine_steps: Vec<V3>,
+}
+
+/// A stable-pushing planning problem.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// Table, walls and obstacles.
+    pub world: World,
+    /// The slider (slider frame at its centre of friction).
+    pub slider: Slider,
+    /// Pusher–slider friction coefficient.
+    pub mu: f64,
+    /// The pusher.
+    pub pusher: Pusher,
+    /// The contacts the pusher may use.
+    pub contacts: Vec<ContactModel>,
+    /// Start configuration.
+    pub start: Pose,
+    /// Goal configuration.
+    pub goal: Pose,
+    /// Parameters.
+    pub params: Params,
+    /// Contact (index into `contacts`) the pusher starts at; `None`: any, for free.
+    pub start_contact: Option<usize>,
+}
+
+impl Problem {
+    /// Build a problem: run STABLE on each listed edge, intersect with the pusher's feasible
+    /// pushes, scale the extremal directions to one step.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        world: World,
+        slider: Slider,
+        mu: f64,
+        pusher: Pusher,
+        edges: &[usize],
+        start: Pose,
+        goal: Pose,
+        params: Params,
+    ) -> Result<Self, MechanicsError> {
+        let mut contacts = Vec::new();
+        for &e in edges {
+            let placement = pusher.placement(&slider, e)?;
+            let st = stable(&slider, &placement.contact, mu)?;
+            let usable = pusher.usable(&st, &placement);
+            let footprint: Vec<V2> = pusher
+                .footprint
+                .iter()
+                .map(|p| placement.to_slider(*p))
+                .collect();
+            let mut parts = vec![slider.vertices.clone()];
+            if !footprint.is_empty() {
+                parts.push(footprint.clone());
+            }
+            let body = Body::new(&parts);
+            let steps = usable
+                .controls
+                .iter()
+                .map(|v| step_twist(&slider, v, params.step))
+                .collect();
+            let fine = params.step / params.fine_factor.max(1.0);
+            let fine_steps = usable
+                .controls
+                .iter()
+                .map(|v| step_twist(&slider, v, fine))
+                .collect();
+            contacts.push(ContactModel {
+                edge: e,
+                placement,
+                usable,
+                body,
+                footprint,
+                steps,
+                fine_steps,
+            });
+        }
+        Ok(Problem {
+            world,
+            slider,
+            mu,
+            pusher,
+            contacts,
+            start,
+            goal,
+            params,
+            start_contact: None,
+        })
+    }
+
+    /// Whether `q` is in the refined region around the goal (§4.5).
+    pub fn near_goal(&self, q: &Pose) -> bool {
+        self.params.fine_factor > 1.0
+            && (q.x - self.goal.x).hypot(q.y - self.goal.y) <= self.params.fine_radius
+    }
+
+    /// The step twists of contact `ci` at configuration `q`.
+    pub fn steps_at(&self, ci: usize, q: &Pose) -> &[V3] {
+        let cm = &self.contacts[ci];
+        if self.near_goal(q) {
+            &cm.fine_steps
+        } else {
+            &cm.steps
+        }
+    }
+
+    /// Whether `q` is in the goal neighbourhood.
+    pub fn in_goal(&self, q: &Pose) -> bool {
+        (q.x - self.goal.x).abs() <= self.params.goal_xy
+            && (q.y - self.goal.y).abs() <= self.params.goal_xy
+            && angle_diff(q.theta, self.goal.theta).abs() <= self.params.goal_theta
+    }
+}
+
+/// Scale a unit velocity direction so that no slider vertex moves farther than `step` along
+/// its arc.
+pub fn step_twist(slider: &Slider, v: &V3, step: f64) -> V3 {
+    match cor_of(v) {
+        Some(c) => {
+            let rho = slider
+                .vertices
+                .iter()
+                .map(|p| (p - c).norm())
+                .fold(0.0, f64::max);
+            v * (step / rho / v.z.abs())
+        }
+        None => v * (step / (v.x * v.x + v.y * v.y).sqrt()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integrate_and_twist_to_round_trip() {
+        let q = Pose::new(1.0, 2.0, 0.3);
+        for xi in [
+            V3::new(0.2, 0.5, 0.0),
+            V3::new(0.1, 0.3, 0.4),
+            V3::new(-0.3, 0.2, -1.2),
+        ] {
+            let r = q.integrate(&xi);
+            let back = q.twist_to(&r);
+            assert!((back - xi).norm() < 1e-9, "{back:?} vs {xi:?}");
+        }
+        // Rotation about the centre of friction by π/2 keeps the position.
+        let r = q.integrate(&V3::new(0.0, 0.0, PI / 2.0));
+        assert!((r.x - 1.0).abs() < 1e-12 && (r.y - 2.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,525 @@
+//! Scenes for stable pushing, in a small TOML format, and the built-in presets shaped after
+//! Lynch & Mason (1996) §4.4: Fig. 13 (omnidirectional robot, one edge), Fig. 15 (car-like
+//! robot), Figs. 16 and 17 (robot arm, two edges, costs `a=1 b=5 c=0` and `a=0 b=1 c=10`) and
+//! Fig. 18 (cluttered), with goal regions as in the paper (±25 % / ±10 % of the slider length,
+//! ±2°). The slider is shaped after Fig. 12: a box with one corner cut, pushed on two opposite
+//! edges.
+//!
+//! ```toml
+//! name = "example"
+//! table = [1.2, 0.8]            # width, height (m); the table is (0,w) × (0,h)
+//! mu = 0.5                      # pusher–slider friction coefficient
+//! [[obstacles]]                 # convex polygons, world frame
+//! polygon = [[0.5, 0.0], [0.6, 0.0], [0.6, 0.4], [0.5, 0.4]]
+//! [[objects]]
+//! id = "box"
+//! polygon = [[0, 0], [0.2, 0], [0.2, 0.14], [0, 0.14]]   # object frame
+//! # centre_of_friction = [0.1, 0.07]                    # default: area centroid
+//! [task]
+//! object = "box"
+//! start = [0.2, 0.2, 0.0]       # x, y of the centre of friction, θ in degrees
+//! goal = [1.0, 0.6, 90.0]
+//! edges = [0, 2]                # pushing contacts: edges of the object's polygon
+//! goal_xy_frac = 0.1            # goal half-width in x, y as a fraction of the object length
+//! goal_theta_deg = 2.0
+//! [pusher]
+//! kind = "arm"                  # arm | omni | car | diff-drive
+//! [planner]
+//! a = 1
+//! b = 5
+//! c = 0                         # or "inf": contact changes disallowed
+//! ```
+
+use anyhow::{Context, anyhow, bail};
+use serde::Deserialize;
+
+use super::collision::{Obstacle, World};
+use super::pusher::{Pusher, PusherKind};
+use super::{Params, Pose, Problem};
+use crate::mechanics::{Slider, V2, centroid};
+
+/// A stable-pushing scene as written in TOML.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Scene name.
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// Table width and height (m).
+    pub table: [f64; 2],
+    /// Pusher–slider friction coefficient.
+    pub mu: f64,
+    /// Convex obstacles (world frame).
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleSpec>,
+    /// Objects; the task's object is pushed, the others are static obstacles at `pose`.
+    pub objects: Vec<ObjectSpec>,
+    /// What to do.
+    pub task: TaskSpec,
+    /// Who pushes.
+    pub pusher: PusherSpec,
+    /// Planner settings.
+    #[serde(default)]
+    pub planner: PlannerSpec,
+}
+
+/// An obstacle.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSpec {
+    /// Vertices of a convex polygon.
+    pub polygon: Vec<[f64; 2]>,
+}
+
+/// An object.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    /// Identifier.
+    pub id: String,
+    /// Outline in the object frame.
+    pub polygon: Vec<[f64; 2]>,
+    /// Centre of friction in the object frame (default: area centroid).
+    pub centre_of_friction: Option<[f64; 2]>,
+    /// Pose `[x, y, θ°]` for objects that are not pushed (default: not placed).
+    pub pose: Option<[f64; 3]>,
+}
+
+/// The task.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TaskSpec {
+    /// Id of the object to push.
+    pub object: String,
+    /// Start `[x, y, θ°]` of the centre of friction.
+    pub start: [f64; 3],
+    /// Goal `[x, y, θ°]`.
+    pub goal: [f64; 3],
+    /// Edges of the object that may be pushed.
+    pub edges: Vec<usize>,
+    /// Edge the pusher starts at (default: any, chosen for free).
+    pub start_edge: Option<usize>,
+    /// Goal half-width in x and y as a fraction of the object length.
+    pub goal_xy_frac: f64,
+    /// Goal half-width in θ (degrees).
+    pub goal_theta_deg: f64,
+}
+
+/// The pusher.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PusherSpec {
+    /// `arm`, `omni`, `car` or `diff-drive`.
+    pub kind: String,
+    /// Robot width (m).
+    pub width: Option<f64>,
+    /// Robot depth behind its front (m).
+    pub depth: Option<f64>,
+    /// Front plate to wheel axle (m).
+    pub axle_offset: Option<f64>,
+    /// Width of a flat front plate (bumper); default: as wide as the robot.
+    pub plate_width: Option<f64>,
+    /// Car: minimum turning radius (m).
+    pub min_turning_radius: Option<f64>,
+}
+
+/// Planner settings (all optional).
+#[derive(Debug, Clone, Deserialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct PlannerSpec {
+    /// Cost per step.
+    pub a: Option<u32>,
+    /// Cost per control change.
+    pub b: Option<u32>,
+    /// Cost per contact change: integer or "inf".
+    pub c: Option<CostSpec>,
+    /// Step length as a fraction of the object length.
+    pub step_frac: Option<f64>,
+    /// Grid cell in x, y as a fraction of the step.
+    pub grid_xy_frac: Option<f64>,
+    /// Grid cell in θ (degrees).
+    pub grid_theta_deg: Option<f64>,
+    /// MAXCOST.
+    pub max_cost: Option<u32>,
+    /// Node limit.
+    pub max_nodes: Option<usize>,
+    /// Radius around the goal (fraction of the object length) inside which step and grid are
+    /// refined (§4.5); 0 = off.
+    pub fine_radius_frac: Option<f64>,
+    /// Refinement factor for step and grid near the goal.
+    pub fine_factor: Option<f64>,
+}
+
+/// A contact-change cost: a number or "inf".
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum CostSpec {
+    /// Finite.
+    Int(u32),
+    /// "inf".
+    Word(String),
+}
+
+impl CostSpec {
+    /// `None` for ∞.
+    pub fn value(&self) -> anyhow::Result<Option<u32>> {
+        match self {
+            CostSpec::Int(v) => Ok(Some(*v)),
+            CostSpec::Word(w) if w == "inf" => Ok(None),
+            CostSpec::Word(w) => bail!("planner.c: expected an integer or \"inf\", got {w:?}"),
+        }
+    }
+}
+
+/// Names of the built-in presets.
+pub const PRESETS: [&str; 5] = ["fig13", "fig15", "fig16", "fig17", "fig18"];
+
+/// The paper's planning times (s) for the presets, in `PRESETS` order (§4.4).
+pub const PAPER_SECONDS: [f64; 5] = [7.0, 1.0, 35.0, 2.0, 43.0];
+
+const SLIDER: &str = r#"
+[[objects]]
+id = "slider"
+polygon = [[0.0, 0.0], [0.20, 0.0], [0.20, 0.10], [0.15, 0.14], [0.0, 0.14]]
+"#;
+
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
+    format!("[[obstacles]]\npolygon = [[{x0}, {y0}], [{x1}, {y0}], [{x1}, {y1}], [{x0}, {y1}]]\n")
+}
+
+const PLANNER: &str = "step_frac = 0.3\ngrid_xy_frac = 1.0\ngrid_theta_deg = 6.0\nfine_radius_frac = 1.0\n\
+fine_factor = 3.0\nmax_cost = 3000\nmax_nodes = 300000\n";
+
+fn preset_text(name: &str) -> Option<String> {
+    // (figure, table, obstacles, start, goal, edges, goal fraction, pusher, (a, b, c))
+    let (fig, table, obstacles, start, goal, edges, frac, pusher, (a, b, c)) = match name {
+        "fig13" => (
+            13,
+            "[2.4, 1.6]",
+            rect(1.0, 0.0, 1.2, 0.8) + &rect(1.6, 1.1, 1.8, 1.6),
+            "[0.4, 0.4, -90.0]",
+            "[2.0, 0.4, -90.0]",
+            "[0]",
+            0.25,
+            "kind = \"omni\"\nwidth = 0.2\ndepth = 0.12\n",
+            (1, 5, "\"inf\""),
+        ),
+        "fig15" => (
+            15,
+            "[2.4, 1.6]",
+            rect(1.1, 0.0, 1.3, 0.6) + &rect(0.0, 1.2, 0.7, 1.6),
+            "[0.4, 0.4, -90.0]",
+            "[2.0, 1.2, -90.0]",
+            "[0]",
+            0.25,
+            "kind = \"car\"\nwidth = 0.2\ndepth = 0.18\naxle_offset = 0.15\nmin_turning_radius = 0.3\n",
+            (1, 5, "\"inf\""),
+        ),
+        "fig16" | "fig17" => (
+            if name == "fig16" { 16 } else { 17 },
+            "[1.2, 0.8]",
+            rect(0.0, 0.45, 0.5, 0.8) + &rect(0.85, 0.45, 1.2, 0.8),
+            "[0.25, 0.2, 0.0]",
+            "[0.675, 0.62, 90.0]",
+            "[0, 3]",
+            0.1,
+            "kind = \"arm\"\n",
+            if name == "fig16" {
+                (1, 5, "0")
+            } else {
+                (0, 1, "10")
+            },
+        ),
+        "fig18" => (
+            18,
+            "[1.6, 1.2]",
+            rect(0.45, 0.0, 0.6, 0.5)
+                + &rect(0.45, 0.85, 0.6, 1.2)
+                + &rect(0.9, 0.4, 1.05, 1.2)
+                + &rect(1.35, 0.0, 1.6, 0.25)
+                + &rect(0.15, 0.85, 0.3, 1.0)
+                + &rect(1.3, 1.05, 1.45, 1.2),
+            "[0.2, 0.25, 90.0]",
+            "[1.3, 0.9, 0.0]",
+            "[0, 3]",
+            0.1,
+            "kind = \"arm\"\n",
+            (0, 1, "10"),
+        ),
+        _ => return None,
+    };
+    Some(format!(
+        r#"name = "{name}"
+description = "Shaped after Lynch & Mason Fig. {fig}: edges {edges}, goal ±{pct} % of the slider length and ±2°, cost a={a} b={b} c={}."
+table = {table}
+mu = 0.5
+{obstacles}{SLIDER}
+[task]
+object = "slider"
+start = {start}
+goal = {goal}
+edges = {edges}
+goal_xy_frac = {frac}
+goal_theta_deg = 2.0
+[pusher]
+{pusher}[planner]
+a = {a}
+b = {b}
+c = {c}
+{PLANNER}"#,
+        c.trim_matches('"'),
+        pct = frac * 100.0
+    ))
+}
+
+/// Parse a scene from TOML text. Errors name the line (syntax, types) or the field (values).
+pub fn parse_scene(text: &str) -> anyhow::Result<Scene> {
+    let s: Scene = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+    validate(&s)?;
+    Ok(s)
+}
+
+/// Load a scene by preset name or from a TOML file.
+pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
+    if let Some(t) = preset_text(name_or_path) {
+        return parse_scene(&t).with_context(|| format!("preset {name_or_path}"));
+    }
+    let text = std::fs::read_to_string(name_or_path).with_context(|| {
+        format!(
+            "scene {name_or_path:?} is neither a preset ({}) nor a readable file",
+            PRESETS.join(", ")
+        )
+    })?;
+    parse_scene(&text).with_context(|| format!("scene file {name_or_path}"))
+}
+
+fn finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn validate(s: &Scene) -> anyhow::Result<()> {
+    if !(s.table[0] > 0.0 && s.table[1] > 0.0 && finite(&s.table)) {
+        bail!("table: width and height must be finite and > 0");
+    }
+    if !(s.mu >= 0.0 && s.mu.is_finite()) {
+        bail!("mu: must be finite and >= 0, got {}", s.mu);
+    }
+    for (i, o) in s.obstacles.iter().enumerate() {
+        if o.polygon.len() < 3 || !o.polygon.iter().all(|p| finite(p)) {
+            bail!("obstacles[{i}].polygon: needs at least 3 finite points");
+        }
+        if Obstacle::new(&pts(&o.polygon)).is_none() {
+            bail!("obstacles[{i}].polygon: degenerate polygon");
+        }
+    }
+    for (i, o) in s.objects.iter().enumerate() {
+        if o.polygon.len() < 3 || !o.polygon.iter().all(|p| finite(p)) {
+            bail!("objects[{i}].polygon: needs at least 3 finite points");
+        }
+    }
+    if !s.objects.iter().any(|o| o.id == s.task.object) {
+        bail!("task.object: no object with id {:?}", s.task.object);
+    }
+    if !finite(&s.task.start) || !finite(&s.task.goal) {
+        bail!("task.start/goal: must be finite");
+    }
+    if s.task.edges.is_empty() {
+        bail!("task.edges: at least one pushing edge is needed");
+    }
+    if let Some(e) = s.task.start_edge
+        && !s.task.edges.contains(&e)
+    {
+        bail!("task.start_edge: edge {e} is not in task.edges");
+    }
+    if !(s.task.goal_xy_frac > 0.0 && s.task.goal_theta_deg > 0.0) {
+        bail!("task.goal_xy_frac and task.goal_theta_deg: must be > 0");
+    }
+    let p = &s.planner;
+    for (name, v) in [
+        ("step_frac", p.step_frac),
+        ("grid_xy_frac", p.grid_xy_frac),
+        ("grid_theta_deg", p.grid_theta_deg),
+        ("fine_factor", p.fine_factor),
+    ] {
+        if let Some(v) = v
+            && !(v > 0.0 && v.is_finite())
+        {
+            bail!("planner.{name}: must be finite and > 0, got {v}");
+        }
+    }
+    if let Some(c) = &p.c {
+        c.value()?;
+    }
+    if let Some(v) = p.fine_radius_frac
+        && !(v >= 0.0 && v.is_finite())
+    {
+        bail!("planner.fine_radius_frac: must be finite and >= 0, got {v}");
+    }
+    if p.max_cost.is_some_and(|m| m > 1_000_000) {
+        bail!("planner.max_cost: at most 1000000");
+    }
+    match s.pusher.kind.as_str() {
+        "arm" | "omni" | "car" | "diff-drive" => {}
+        k => bail!("pusher.kind: expected arm, omni, car or diff-drive, got {k:?}"),
+    }
+    if s.pusher.kind == "car" && s.pusher.min_turning_radius.is_none() {
+        bail!("pusher.min_turning_radius: required for a car");
+    }
+    for (name, v) in [
+        ("width", s.pusher.width),
+        ("depth", s.pusher.depth),
+        ("axle_offset", s.pusher.axle_offset),
+        ("plate_width", s.pusher.plate_width),
+        ("min_turning_radius", s.pusher.min_turning_radius),
+    ] {
+        if let Some(v) = v
+            && !(v >= 0.0 && v.is_finite())
+        {
+            bail!("pusher.{name}: must be finite and >= 0, got {v}");
+        }
+    }
+    Ok(())
+}
+
+fn pts(p: &[[f64; 2]]) -> Vec<V2> {
+    p.iter().map(|q| V2::new(q[0], q[1])).collect()
+}
+
+/// Overrides of the scene's planner costs.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CostOverride {
+    /// `a`.
+    pub a: Option<u32>,
+    /// `b`.
+    pub b: Option<u32>,
+    /// `c`: `Some(None)` = ∞.
+    pub c: Option<Option<u32>>,
+}
+
+impl Scene {
+    /// The slider of object `id` (slider frame at its centre of friction).
+    pub fn slider(&self, id: &str) -> anyhow::Result<Slider> {
+        let o = self
+            .objects
+            .iter()
+            .find(|o| o.id == id)
+            .ok_or_else(|| anyhow!("no object with id {id:?}"))?;
+        let outline = pts(&o.polygon);
+        let cof = o
+            .centre_of_friction
+            .map(|c| V2::new(c[0], c[1]))
+            .unwrap_or_else(|| centroid(&outline));
+        Slider::new(&outline, cof).map_err(|e| anyhow!("objects[{id}]: {e}"))
+    }
+
+    /// The pusher.
+    pub fn pusher(&self) -> Pusher {
+        let p = &self.pusher;
+        let w = p.width.unwrap_or(0.1);
+        let d = p.depth.unwrap_or(0.1);
+        let axle = p.axle_offset.unwrap_or(d / 2.0);
+        let plate = p.plate_width.or(Some(w));
+        match p.kind.as_str() {
+            "omni" => Pusher::boxed(PusherKind::Omni, w, d, d / 2.0, plate),
+            "car" => Pusher::boxed(
+                PusherKind::Car {
+                    min_turning_radius: p.min_turning_radius.unwrap_or(0.0),
+                },
+                w,
+                d,
+                axle,
+                plate,
+            ),
+            "diff-drive" => Pusher::boxed(PusherKind::DiffDrive, w, d, axle, plate),
+            _ => Pusher::arm(),
+        }
+    }
+
+    /// Build the planning problem.
+    pub fn problem(&self, costs: CostOverride) -> anyhow::Result<Problem> {
+        let slider = self.slider(&self.task.object)?;
+        let len = slider.length();
+        let pl = &self.planner;
+        let step = pl.step_frac.unwrap_or(0.2) * len;
+        let c = match costs.c {
+            Some(c) => c,
+            None => {
+                pl.c.as_ref()
+                    .map(|c| c.value())
+                    .transpose()?
+                    .unwrap_or(Some(0))
+            }
+        };
+        let params = Params {
+            a: costs.a.or(pl.a).unwrap_or(1),
+            b: costs.b.or(pl.b).unwrap_or(5),
+            c,
+            step,
+            grid_xy: step * pl.grid_xy_frac.unwrap_or(0.5),
+            grid_theta: pl.grid_theta_deg.unwrap_or(2.0).to_radians(),
+            goal_xy: self.task.goal_xy_frac * len,
+            goal_theta: self.task.goal_theta_deg.to_radians(),
+            max_cost: pl.max_cost.unwrap_or(3000),
+            max_nodes: pl.max_nodes.unwrap_or(200_000),
+            fine_radius: pl.fine_radius_frac.unwrap_or(0.0) * len,
+            fine_factor: pl.fine_factor.unwrap_or(1.0).max(1.0),
+        };
+        let mut obstacles = Vec::new();
+        for o in &self.obstacles {
+            obstacles.push(
+                Obstacle::new(&pts(&o.polygon)).ok_or_else(|| anyhow!("degenerate obstacle"))?,
+            );
+        }
+        for o in &self.objects {
+            if o.id == self.task.object {
+                continue;
+            }
+            if let Some(pose) = o.pose {
+                let s = self.slider(&o.id)?;
+                let q = Pose::new(pose[0], pose[1], pose[2].to_radians());
+                let w: Vec<V2> = s.vertices.iter().map(|v| q.apply(*v)).collect();
+                obstacles.push(
+                    Obstacle::new(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?,
+                );
+            }
+        }
+        let world = World::new(self.table[0], self.table[1], obstacles);
+        let t = &self.task;
+        let start = Pose::new(t.start[0], t.start[1], t.start[2].to_radians());
+        let goal = Pose::new(t.goal[0], t.goal[1], t.goal[2].to_radians());
+        let mut problem = Problem::new(
+            world,
+            slider,
+            self.mu,
+            self.pusher(),
+            &t.edges,
+            start,
+            goal,
+            params,
+        )
+        .map_err(|e| anyhow!("task.edges: {e}"))?;
+        problem.start_contact = t
+            .start_edge
+            .and_then(|e| t.edges.iter().position(|&x| x == e));
+        for (i, cm) in problem.contacts.iter().enumerate() {
+            if cm.usable.controls.is_empty() {
+                bail!(
+                    "task.edges[{i}]: edge {} has no usable stable push for this pusher",
+                    cm.edge
+                );
+            }
+        }
+        if !problem
+            .contacts
+            .iter()
+            .any(|cm| cm.body.free_at(&problem.world, &start))
+        {
+            bail!(
+                "task.start: the slider and pusher collide with an obstacle or wall at the start"
+            );
+        }
+        Ok(problem)
+    }
+}

@@ -1,0 +1,493 @@
+//! The best-first push planner of Lynch & Mason (1996) §4.1–4.2 (after Barraquand & Latombe
+//! 1993): OPEN is a 1-D array of FIFO lists indexed by integer cost (§4.2.2), a configuration is
+//! expanded only if its grid cell has not been occupied with the same contact (§4.2.3), and the
+//! search stops at the goal neighbourhood, at MAXCOST or at the node limit (§4.2.4).
+//!
+//! Costs: each push step costs `a`; a step whose control (contact and direction) differs from
+//! the previous step's costs `b` more; a step on a different contact than the previous step
+//! costs `c` more (a contact change is also a control change). For a mobile pusher a
+//! contact-changing step is accepted only if a transit path exists (§4.6); that path is found
+//! lazily, when the node is taken from OPEN, and kept in the plan. The exact-goal variant of
+//! §4.5 backs up along the found path to a configuration from which one stable push reaches the
+//! goal exactly.
+
+use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
+use std::time::Instant;
+
+use super::collision;
+use super::transit::{TransitPath, transit};
+use super::{Pose, Problem};
+use crate::mechanics::V3;
+
+const NONE: u32 = u32::MAX;
+
+/// A small multiplicative hasher for the pruning grid's integer keys (SipHash is the search's
+/// bottleneck otherwise).
+#[derive(Default)]
+struct GridHasher(u64);
+
+impl Hasher for GridHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(u64::from(*b));
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+}
+
+type GridSet = HashSet<(i64, i64, i64, u32), BuildHasherDefault<GridHasher>>;
+
+/// One push step of a plan.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Step {
+    /// Index into the problem's contacts.
+    pub contact: usize,
+    /// Slider edge of that contact.
+    pub edge: usize,
+    /// Control index within the contact's controls (`usize::MAX` for an exact-goal push).
+    pub control: usize,
+    /// Configuration before the step.
+    pub from: Pose,
+    /// Configuration after the step.
+    pub to: Pose,
+    /// Slider-frame twist integrated over the step.
+    pub twist: [f64; 3],
+}
+
+/// A plan and the search statistics.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Plan {
+    /// Whether a path to the goal neighbourhood was found.
+    pub found: bool,
+    /// Total cost `a·pushes + b·control changes + c·contact changes`.
+    pub cost: u32,
+    /// Number of push steps.
+    pub pushes: usize,
+    /// Number of control changes.
+    pub control_changes: usize,
+    /// Number of contact changes.
+    pub contact_changes: usize,
+    /// Configurations expanded.
+    pub nodes_expanded: usize,
+    /// Planning time (ms).
+    pub plan_time_ms: f64,
+    /// The push steps.
+    pub steps: Vec<Step>,
+    /// Transit paths of the pusher, one per contact change.
+    pub transits: Vec<TransitPath>,
+    /// Whether the plan ends exactly at the goal (§4.5 variant).
+    pub exact_goal: bool,
+}
+
+/// Which OPEN list to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Queue {
+    /// The paper's array of lists indexed by integer cost.
+    Buckets,
+    /// A binary heap ordered by (cost, insertion order); for cross-checking.
+    Heap,
+}
+
+#[derive(Clone)]
+struct Node {
+    q: Pose,
+    contact: u32,
+    control: u32,
+    parent: u32,
+    cost: u32,
+    needs_transit: bool,
+    transit: u32,
+}
+
+/// Plan with the paper's bucketed OPEN list.
+pub fn plan(p: &Problem) -> Plan {
+    plan_with(p, Queue::Buckets)
+}
+
+/// The grid cell of a configuration.
+fn cell(p: &Problem, q: &Pose, contact: u32) -> (i64, i64, i64, u32) {
+    let th = q.theta.rem_euclid(2.0 * std::f64::consts::PI);
+    // Refined cells near the goal carry a tag so they never share a key with coarse cells.
+    let (f, tag) = if p.near_goal(q) {
+        (p.params.fine_factor, 1i64 << 40)
+    } else {
+        (1.0, 0)
+    };
+    (
+        (q.x * f / p.params.grid_xy).floor() as i64 + tag,
+        (q.y * f / p.params.grid_xy).floor() as i64,
+        (th * f / p.params.grid_theta).floor() as i64,
+        contact,
+    )
+}
+
+/// Cost of a step given the previous step's (contact, control).
+pub fn step_cost(
+    p: &Problem,
+    prev: Option<(usize, usize)>,
+    contact: usize,
+    control: usize,
+) -> Option<u32> {
+    let mut c = p.params.a;
+    // Saturating: costs come from the command line.
+    if let Some((pc, pk)) = prev {
+        // `pk == usize::MAX`: the pusher waits at its start contact, no control yet; leaving
+        // that contact is still a contact (and so a control) change.
+        if (pc, pk) != (contact, control) && (pk != usize::MAX || pc != contact) {
+            c = c.saturating_add(p.params.b);
+        }
+        if pc != contact {
+            c = c.saturating_add(p.params.c?);
+        }
+    }
+    Some(c)
+}
+
+/// Plan with the given OPEN list.
+pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
+    let t0 = Instant::now();
+    let mut nodes: Vec<Node> = vec![Node {
+        q: p.start,
+        contact: p.start_contact.map_or(NONE, |c| c as u32),
+        control: NONE,
+        parent: NONE,
+        cost: 0,
+        needs_transit: false,
+        transit: NONE,
+    }];
+    let mut transits: Vec<TransitPath> = Vec::new();
+    let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
+    let mut occupied: GridSet = GridSet::default();
+    let max_cost = p.params.max_cost as usize;
+    let mut buckets: Vec<std::collections::VecDeque<u32>> = vec![Default::default(); max_cost + 1];
+    let mut heap: BinaryHeap<std::cmp::Reverse<(u32, u32)>> = BinaryHeap::new();
+    let mut cur = 0usize;
+    let push = |buckets: &mut Vec<std::collections::VecDeque<u32>>,
+                heap: &mut BinaryHeap<std::cmp::Reverse<(u32, u32)>>,
+                cost: u32,
+                id: u32| match queue {
+        Queue::Buckets => buckets[cost as usize].push_back(id),
+        Queue::Heap => heap.push(std::cmp::Reverse((cost, id))),
+    };
+    push(&mut buckets, &mut heap, 0, 0);
+    let mut expanded = 0usize;
+    let mut goal_node = None;
+    // The start must be free for some contact's body; each step checks its own body.
+    loop {
+        let id = match queue {
+            Queue::Buckets => {
+                while cur <= max_cost && buckets[cur].is_empty() {
+                    cur += 1;
+                }
+                if cur > max_cost {
+                    break;
+                }
+                buckets[cur].pop_front().expect("non-empty bucket")
+            }
+            Queue::Heap => match heap.pop() {
+                Some(std::cmp::Reverse((_, id))) => id,
+                None => break,
+            },
+        };
+        let n = nodes[id as usize].clone();
+        if n.needs_transit {
+            let key = (n.parent, n.contact);
+            let t = *transit_cache.entry(key).or_insert_with(|| {
+                let par = &nodes[n.parent as usize];
+                transit(
+                    p,
+                    &par.q,
+                    par.contact as usize,
+                    n.contact as usize,
+                    nodes.len() as u32,
+                )
+                .map(|tp| {
+                    transits.push(tp);
+                    (transits.len() - 1) as u32
+                })
+            });
+            match t {
+                Some(ti) => nodes[id as usize].transit = ti,
+                None => continue,
+            }
+        }
+        if p.in_goal(&n.q) {
+            goal_node = Some(id);
+            break;
+        }
+        let key = cell(p, &n.q, n.contact);
+        if n.contact != NONE && !occupied.insert(key) {
+            continue;
+        }
+        if expanded >= p.params.max_nodes {
+            break;
+        }
+        expanded += 1;
+        let prev = (n.contact != NONE).then_some((
+            n.contact as usize,
+            if n.control == NONE {
+                usize::MAX
+            } else {
+                n.control as usize
+            },
+        ));
+        for (ci, cm) in p.contacts.iter().enumerate() {
+            // One clearance measurement at q serves every step of this contact.
+            let steps = p.steps_at(ci, &n.q);
+            let max_reach = steps.iter().map(|xi| cm.body.reach(xi)).fold(0.0, f64::max);
+            let d0 = cm
+                .body
+                .clearance(&p.world, &n.q, max_reach + collision::CONTACT_EPS);
+            for (k, xi) in steps.iter().enumerate() {
+                let Some(dc) = step_cost(p, prev, ci, k) else {
+                    continue;
+                };
+                let cost = n.cost.saturating_add(dc);
+                if cost > p.params.max_cost {
+                    continue;
+                }
+                let q2 = n.q.integrate(xi);
+                if occupied.contains(&cell(p, &q2, ci as u32)) {
+                    continue;
+                }
+                if !cm.body.step_free_from(&p.world, &n.q, xi, Some(d0)) {
+                    continue;
+                }
+                let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
+                nodes.push(Node {
+                    q: q2,
+                    contact: ci as u32,
+                    control: k as u32,
+                    parent: id,
+                    cost,
+                    needs_transit,
+                    transit: NONE,
+                });
+                push(&mut buckets, &mut heap, cost, (nodes.len() - 1) as u32);
+            }
+        }
+    }
+    let mut plan = Plan {
+        found: false,
+        cost: 0,
+        pushes: 0,
+        control_changes: 0,
+        contact_changes: 0,
+        nodes_expanded: expanded,
+        plan_time_ms: 0.0,
+        steps: vec![],
+        transits: vec![],
+        exact_goal: false,
+    };
+    if let Some(g) = goal_node {
+        let mut chain = Vec::new();
+        let mut i = g;
+        while nodes[i as usize].parent != NONE {
+            chain.push(i);
+            i = nodes[i as usize].parent;
+        }
+        chain.reverse();
+        for &i in &chain {
+            let n = &nodes[i as usize];
+            let par = &nodes[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize];
+            plan.steps.push(Step {
+                contact: n.contact as usize,
+                edge: cm.edge,
+                control: n.control as usize,
+                from: par.q,
+                to: n.q,
+                twist: [xi.x, xi.y, xi.z],
+            });
+            if n.transit != NONE {
+                plan.transits.push(transits[n.transit as usize].clone());
+            }
+        }
+        plan.found = true;
+        plan.cost = nodes[g as usize].cost;
+        summarise(p, &mut plan);
+    }
+    plan.plan_time_ms = t0.elapsed().as_secs_f64() * 1e3;
+    plan
+}
+
+/// Fill in the counts (and recompute the cost) from the steps.
+pub fn summarise(p: &Problem, plan: &mut Plan) {
+    plan.pushes = plan.steps.len();
+    plan.control_changes = 0;
+    plan.contact_changes = 0;
+    let mut cost = 0u32;
+    let mut prev: Option<(usize, usize)> = p.start_contact.map(|c| (c, usize::MAX));
+    for s in &plan.steps {
+        if let Some((pc, pk)) = prev {
+            if (pc, pk) != (s.contact, s.control) && (pk != usize::MAX || pc != s.contact) {
+                plan.control_changes += 1;
+            }
+            if pc != s.contact {
+                plan.contact_changes += 1;
+            }
+        }
+        cost = cost.saturating_add(step_cost(p, prev, s.contact, s.control).unwrap_or(0));
+        prev = Some((s.contact, s.control));
+    }
+    plan.cost = cost;
+}
+
+/// The exact-goal variant of §4.5: back up along `plan` until a configuration from which a
+/// single usable push of one contact moves `PS` collision-free exactly onto the goal; the
+/// final push is counted as `ceil(length / step)` steps of one control. Only pushers whose
+/// usable set has interior on the velocity sphere (arm, omnidirectional) can do this.
+pub fn exact_goal(p: &Problem, plan: &Plan) -> Option<Plan> {
+    if !plan.found {
+        return None;
+    }
+    for back in (0..=plan.steps.len()).rev() {
+        let q = if back == 0 {
+            p.start
+        } else {
+            plan.steps[back - 1].to
+        };
+        let last_contact = if back == 0 {
+            p.start_contact
+        } else {
+            Some(plan.steps[back - 1].contact)
+        };
+        let xi = q.twist_to(&p.goal);
+        if xi.norm() < 1e-12 {
+            continue;
+        }
+        // Prefer the contact already in use (no transit).
+        let mut order: Vec<usize> = (0..p.contacts.len()).collect();
+        if let Some(lc) = last_contact {
+            order.sort_by_key(|&c| c != lc);
+        }
+        for ci in order {
+            let cm = &p.contacts[ci];
+            if !cm.usable.set.contains(&xi) || !cm.body.step_free(&p.world, &q, &xi) {
+                continue;
+            }
+            let change = last_contact.is_some_and(|lc| lc != ci);
+            if change && p.params.c.is_none() {
+                continue;
+            }
+            let mut out = plan.clone();
+            out.steps.truncate(back);
+            out.transits.clear();
+            let mut transits_needed = vec![];
+            let mut prev_c: Option<usize> = None;
+            for s in &out.steps {
+                if prev_c.is_some_and(|c| c != s.contact) {
+                    transits_needed.push(s.from);
+                }
+                prev_c = Some(s.contact);
+            }
+            out.transits = plan.transits[..transits_needed.len().min(plan.transits.len())].to_vec();
+            if change && p.pusher.is_mobile() {
+                match transit(p, &q, last_contact.unwrap_or(ci), ci, 0) {
+                    Some(t) => out.transits.push(t),
+                    None => continue,
+                }
+            }
+            // Length of the push in step units.
+            let unit = super::step_twist(&p.slider, &xi, p.params.step);
+            let n_steps = (xi.norm() / unit.norm()).ceil().max(1.0) as usize;
+            for k in 0..n_steps {
+                let a = xi * (k as f64 / n_steps as f64);
+                let b = xi * ((k + 1) as f64 / n_steps as f64);
+                let from = q.integrate(&a);
+                let to = if k + 1 == n_steps {
+                    p.goal
+                } else {
+                    q.integrate(&b)
+                };
+                let tw = xi / n_steps as f64;
+                out.steps.push(super::search::Step {
+                    contact: ci,
+                    edge: cm.edge,
+                    control: usize::MAX,
+                    from,
+                    to,
+                    twist: [tw.x, tw.y, tw.z],
+                });
+            }
+            summarise(p, &mut out);
+            out.exact_goal = true;
+            return Some(out);
+        }
+    }
+    None
+}
+
+/// Brute-force uniform-cost search over the same step discretisation *without grid pruning*,
+/// exploring every control sequence up to `depth` steps; returns the least cost that reaches
+/// the goal neighbourhood (no transit checks: for arm pushers). For testing the planner's
+/// optimality claims (§4.3) on small instances.
+pub fn brute_force_cost(p: &Problem, depth: usize) -> Option<u32> {
+    let mut best: Option<u32> = None;
+    fn rec(
+        p: &Problem,
+        q: Pose,
+        prev: Option<(usize, usize)>,
+        cost: u32,
+        depth: usize,
+        best: &mut Option<u32>,
+    ) {
+        if best.is_some_and(|b| cost >= b) {
+            return;
+        }
+        if prev.is_some_and(|(_, k)| k != usize::MAX) && p.in_goal(&q) {
+            *best = Some(cost);
+            return;
+        }
+        if depth == 0 {
+            return;
+        }
+        for (ci, cm) in p.contacts.iter().enumerate() {
+            for (k, xi) in p.steps_at(ci, &q).iter().enumerate() {
+                let Some(dc) = step_cost(p, prev, ci, k) else {
+                    continue;
+                };
+                if cost.saturating_add(dc) > p.params.max_cost
+                    || !cm.body.step_free(&p.world, &q, xi)
+                {
+                    continue;
+                }
+                rec(
+                    p,
+                    q.integrate(xi),
+                    Some((ci, k)),
+                    cost + dc,
+                    depth - 1,
+                    best,
+                );
+            }
+        }
+    }
+    rec(
+        p,
+        p.start,
+        p.start_contact.map(|c| (c, usize::MAX)),
+        0,
+        depth,
+        &mut best,
+    );
+    best
+}
+
+/// The slider-frame twist of a step as a vector.
+pub fn step_twist_of(s: &Step) -> V3 {
+    V3::new(s.twist[0], s.twist[1], s.twist[2])
+}

@@ -1,0 +1,301 @@
+//! Transit paths between pushing contacts for a mobile pusher confined to the plane — the open
+//! problem of Lynch & Mason (1996) §4.6 (a *transit path* in the terms of Alami et al.).
+//!
+//! With the slider still at configuration `q`, the robot backs straight away from its edge
+//! until the disk it sweeps when turning in place (about its axle centre) clears the slider,
+//! drives as that disk along a shortest path of a visibility graph among the obstacles and the
+//! slider, each grown by the disk's radius (Minkowski sum with a circumscribed octagon, so the
+//! growth is conservative), and drives straight onto the new edge. The two straight legs are
+//! checked with the exact footprint.
+
+use std::collections::BinaryHeap;
+
+use super::collision::{Body, Obstacle};
+use super::{Pose, Problem};
+use crate::mechanics::{V2, V3, convex_hull};
+
+/// A transit path of the pusher between two contacts.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct TransitPath {
+    /// Contact index left.
+    pub from_contact: usize,
+    /// Contact index reached.
+    pub to_contact: usize,
+    /// Slider configuration during the transit.
+    pub at: Pose,
+    /// Way points of the robot's axle centre (world frame), from contact to contact.
+    pub waypoints: Vec<[f64; 2]>,
+    /// Path length (m).
+    pub length: f64,
+}
+
+/// Whether segment `p0 → p1` passes through the interior of the convex polygon `poly`
+/// (counter-clockwise), by Cyrus–Beck clipping.
+pub fn segment_hits_convex(p0: V2, p1: V2, poly: &[V2]) -> bool {
+    let eps = 1e-9;
+    let (mut tl, mut th) = (0.0f64, 1.0f64);
+    let d = p1 - p0;
+    let n = poly.len();
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        let e = b - a;
+        let out = V2::new(e.y, -e.x).normalize();
+        let num = out.dot(&(p0 - a)) + eps;
+        let den = out.dot(&d);
+        if den.abs() < 1e-15 {
+            if num > 0.0 {
+                return false;
+            }
+        } else {
+            let t = -num / den;
+            if den > 0.0 {
+                th = th.min(t);
+            } else {
+                tl = tl.max(t);
+            }
+        }
+        if tl >= th {
+            return false;
+        }
+    }
+    th - tl > 1e-12
+}
+
+/// Whether `p` lies strictly inside the convex polygon `poly`.
+fn inside_convex(p: V2, poly: &[V2]) -> bool {
+    let n = poly.len();
+    (0..n).all(|i| {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        crate::mechanics::cross(b - a, p - a) > 1e-9
+    })
+}
+
+/// `poly` grown by a disk of radius `r` (conservatively: a circumscribed octagon).
+pub fn grow(poly: &[V2], r: f64) -> Vec<V2> {
+    let k = 8;
+    let rr = r / (std::f64::consts::PI / k as f64).cos();
+    let mut pts = Vec::with_capacity(poly.len() * k);
+    for p in poly {
+        for j in 0..k {
+            let a = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / k as f64;
+            pts.push(p + V2::new(a.cos(), a.sin()) * rr);
+        }
+    }
+    convex_hull(&pts)
+}
+
+/// Shortest path for a disk of radius `r` from `s` to `g` among convex obstacles inside a
+/// `w × h` table (visibility graph + Dijkstra). Returns the way points.
+pub fn disk_path(
+    s: V2,
+    g: V2,
+    r: f64,
+    table: (f64, f64),
+    obstacles: &[Vec<V2>],
+) -> Option<Vec<V2>> {
+    let grown: Vec<Vec<V2>> = obstacles.iter().map(|o| grow(o, r)).collect();
+    let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
+    let free_pt = |p: V2| in_table(p) && !grown.iter().any(|o| inside_convex(p, o));
+    if !free_pt(s) || !free_pt(g) {
+        return None;
+    }
+    let mut nodes = vec![s, g];
+    for o in &grown {
+        let c = o.iter().sum::<V2>() / o.len() as f64;
+        for v in o {
+            let p = v + (v - c).normalize() * 1e-6;
+            if free_pt(p) {
+                nodes.push(p);
+            }
+        }
+    }
+    let visible = |a: V2, b: V2| !grown.iter().any(|o| segment_hits_convex(a, b, o));
+    let n = nodes.len();
+    let mut dist = vec![f64::INFINITY; n];
+    let mut prev = vec![usize::MAX; n];
+    let mut done = vec![false; n];
+    dist[0] = 0.0;
+    let mut heap = BinaryHeap::new();
+    heap.push(std::cmp::Reverse((0u64, 0usize)));
+    while let Some(std::cmp::Reverse((_, u))) = heap.pop() {
+        if done[u] {
+            continue;
+        }
+        done[u] = true;
+        if u == 1 {
+            break;
+        }
+        for v in 0..n {
+            if done[v] {
+                continue;
+            }
+            let d = dist[u] + (nodes[v] - nodes[u]).norm();
+            if d < dist[v] && visible(nodes[u], nodes[v]) {
+                dist[v] = d;
+                prev[v] = u;
+                heap.push(std::cmp::Reverse(((d * 1e9) as u64, v)));
+            }
+        }
+    }
+    if !dist[1].is_finite() {
+        return None;
+    }
+    let mut path = vec![g];
+    let mut i = 1;
+    while prev[i] != usize::MAX {
+        i = prev[i];
+        path.push(nodes[i]);
+    }
+    path.reverse();
+    Some(path)
+}
+
+/// The robot's straight leg between its contact on `contact` (slider at `q`) and a stand-off
+/// point where its turning disk clears the slider. Returns the world axle-centre positions at
+/// the contact and at the stand-off, or `None` if the footprint would collide on the way.
+fn leg(p: &Problem, q: &Pose, contact: usize, r: f64) -> Option<(V2, V2)> {
+    let cm = &p.contacts[contact];
+    let pl = &cm.placement;
+    let axle_s = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
+    let back_dir = -pl.normal;
+    // Back off until the disk about the axle clears every slider vertex and edge.
+    let slider = &p.slider.vertices;
+    let clear = |c: V2| {
+        let n = slider.len();
+        (0..n).all(|i| point_segment_distance(c, slider[i], slider[(i + 1) % n]) > r + 1e-4)
+    };
+    let mut b = 0.0;
+    while !clear(axle_s + back_dir * b) {
+        b += 0.01;
+        if b > 10.0 * (r + p.slider.radius()) {
+            return None;
+        }
+    }
+    // The footprint alone translates by b along −n (slider frame), checked exactly.
+    let foot = Body::new(std::slice::from_ref(&cm.footprint));
+    let xi = V3::new(back_dir.x * b, back_dir.y * b, 0.0);
+    if !foot.step_free(&p.world, q, &xi) {
+        return None;
+    }
+    Some((q.apply(axle_s), q.apply(axle_s + back_dir * b)))
+}
+
+/// Distance from point `p` to segment `a b`.
+pub fn point_segment_distance(p: V2, a: V2, b: V2) -> f64 {
+    let d = b - a;
+    let t = if d.norm_squared() > 0.0 {
+        ((p - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + d * t - p).norm()
+}
+
+/// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`.
+pub fn transit(p: &Problem, q: &Pose, from: usize, to: usize, _tag: u32) -> Option<TransitPath> {
+    if !p.pusher.is_mobile() || from == to {
+        return Some(TransitPath {
+            from_contact: from,
+            to_contact: to,
+            at: *q,
+            waypoints: vec![],
+            length: 0.0,
+        });
+    }
+    let r = p.pusher.turning_radius_disk();
+    let (c0, s0) = leg(p, q, from, r)?;
+    let (c1, s1) = leg(p, q, to, r)?;
+    let mut obstacles: Vec<Vec<V2>> = p.world.obstacles[p.world.n_walls..]
+        .iter()
+        .map(|o: &Obstacle| o.vertices.clone())
+        .collect();
+    obstacles.push(convex_hull(
+        &p.slider
+            .vertices
+            .iter()
+            .map(|v| q.apply(*v))
+            .collect::<Vec<_>>(),
+    ));
+    let mid = disk_path(s0, s1, r, p.world.table, &obstacles)?;
+    let mut pts = vec![c0];
+    pts.extend(mid);
+    pts.push(c1);
+    let length = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    Some(TransitPath {
+        from_contact: from,
+        to_contact: to,
+        at: *q,
+        waypoints: pts.iter().map(|p| [p.x, p.y]).collect(),
+        length,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_through_square_hits_and_grazing_does_not() {
+        let sq = [
+            V2::new(0.0, 0.0),
+            V2::new(1.0, 0.0),
+            V2::new(1.0, 1.0),
+            V2::new(0.0, 1.0),
+        ];
+        assert!(segment_hits_convex(
+            V2::new(-1.0, 0.5),
+            V2::new(2.0, 0.5),
+            &sq
+        ));
+        assert!(!segment_hits_convex(
+            V2::new(-1.0, 1.0),
+            V2::new(2.0, 1.0),
+            &sq
+        ));
+        assert!(!segment_hits_convex(
+            V2::new(-1.0, 2.0),
+            V2::new(2.0, 1.5),
+            &sq
+        ));
+    }
+
+    #[test]
+    fn disk_goes_around_a_wall() {
+        // A wall across the middle with a gap at the top: the path must pass the gap.
+        let wall = vec![
+            V2::new(4.5, 0.0),
+            V2::new(5.5, 0.0),
+            V2::new(5.5, 8.0),
+            V2::new(4.5, 8.0),
+        ];
+        let path = disk_path(
+            V2::new(1.0, 1.0),
+            V2::new(9.0, 1.0),
+            0.5,
+            (10.0, 10.0),
+            &[wall],
+        )
+        .unwrap();
+        let len: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        // Lower bound: the centre must cross x ∈ [4.5, 5.5] at y ≥ 8 (over the wall's top).
+        let lb = (V2::new(4.5, 8.0) - V2::new(1.0, 1.0)).norm()
+            + 1.0
+            + (V2::new(9.0, 1.0) - V2::new(5.5, 8.0)).norm();
+        assert!(len >= lb - 1e-6 && len < lb + 1.5, "len {len} lb {lb}");
+        assert!(
+            disk_path(
+                V2::new(1.0, 1.0),
+                V2::new(9.0, 1.0),
+                1.2,
+                (10.0, 10.0),
+                &[vec![
+                    V2::new(4.5, 0.0),
+                    V2::new(5.5, 0.0),
+                    V2::new(5.5, 10.0),
+                    V2::new(4.5, 10.0)
+                ]]
+            )
+            .is_none()
+        );
+    }
+}

@@ -1,0 +1,291 @@
+//! The minimal scene description vision needs until the shared scene format carries it: the
+//! table's size, the calibration markers fixed at known table positions, and which marker sits
+//! where on which body (robot, objects, goals), as in Lau et al. §IV (markers on the robot, the
+//! object and the goal).
+
+use std::path::Path;
+
+use pushbot_sim::camera::{MarkerFamily, MarkerPlacement};
+use serde::{Deserialize, Serialize};
+
+/// A planar pose on the table: metres and radians (CCW from the table's +x).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Pose {
+    /// x, metres.
+    pub x: f64,
+    /// y, metres.
+    pub y: f64,
+    /// Heading, radians in (−π, π].
+    pub theta: f64,
+}
+
+impl Pose {
+    /// A pose.
+    pub fn new(x: f64, y: f64, theta: f64) -> Pose {
+        Pose { x, y, theta }
+    }
+
+    /// `self ∘ local`: the pose `local` (given in this pose's frame) in the outer frame.
+    pub fn compose(&self, local: &Pose) -> Pose {
+        let (s, c) = self.theta.sin_cos();
+        Pose {
+            x: self.x + c * local.x - s * local.y,
+            y: self.y + s * local.x + c * local.y,
+            theta: wrap_angle(self.theta + local.theta),
+        }
+    }
+
+    /// The inverse transform.
+    pub fn inverse(&self) -> Pose {
+        let (s, c) = self.theta.sin_cos();
+        Pose {
+            x: -(c * self.x + s * self.y),
+            y: s * self.x - c * self.y,
+            theta: wrap_angle(-self.theta),
+        }
+    }
+}
+
+/// An angle mapped into (−π, π].
+pub fn wrap_angle(a: f64) -> f64 {
+    let t = a.rem_euclid(std::f64::consts::TAU);
+    if t > std::f64::consts::PI {
+        t - std::f64::consts::TAU
+    } else {
+        t
+    }
+}
+
+/// A marker fixed on the table at a known place: used to calibrate the camera.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FixedMarker {
+    /// Tag id.
+    pub id: u32,
+    /// Tag family (default tag36h11).
+    #[serde(default)]
+    pub family: MarkerFamily,
+    /// Centre on the table, metres.
+    pub centre: [f64; 2],
+    /// Heading of the printed tag's +x axis, radians.
+    #[serde(default)]
+    pub heading: f64,
+    /// Side of the black square, metres.
+    pub side: f64,
+}
+
+impl FixedMarker {
+    /// As a placement to render or to take corners from.
+    pub fn placement(&self) -> MarkerPlacement {
+        MarkerPlacement {
+            id: self.id,
+            family: self.family,
+            centre: self.centre,
+            heading: self.heading,
+            side: self.side,
+        }
+    }
+}
+
+/// A marker on a body: its tag and its pose in the body's frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyMarker {
+    /// The body's name (`robot`, `object`, `goal`, …): the id tracking reports.
+    pub body: String,
+    /// Tag id.
+    pub id: u32,
+    /// Tag family (default tag36h11).
+    #[serde(default)]
+    pub family: MarkerFamily,
+    /// Side of the black square, metres.
+    pub side: f64,
+    /// The marker's pose in the body frame `[x, y, θ]` (metres, radians).
+    #[serde(default)]
+    pub offset: [f64; 3],
+}
+
+impl BodyMarker {
+    /// The marker's pose in the body frame.
+    pub fn offset_pose(&self) -> Pose {
+        Pose::new(self.offset[0], self.offset[1], self.offset[2])
+    }
+
+    /// Where the marker is when the body is at `body`.
+    pub fn placement(&self, body: &Pose) -> MarkerPlacement {
+        let m = body.compose(&self.offset_pose());
+        MarkerPlacement {
+            id: self.id,
+            family: self.family,
+            centre: [m.x, m.y],
+            heading: m.theta,
+            side: self.side,
+        }
+    }
+
+    /// The body's pose given its marker's pose.
+    pub fn body_pose(&self, marker: &Pose) -> Pose {
+        marker.compose(&self.offset_pose().inverse())
+    }
+}
+
+/// What vision needs to know of a scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MarkerLayout {
+    /// Table size `[width, depth]`, metres; the table spans `[0, w] × [0, d]`.
+    pub table: [f64; 2],
+    /// Markers fixed on the table for calibration.
+    #[serde(default)]
+    pub calibration: Vec<FixedMarker>,
+    /// Markers on bodies.
+    #[serde(default)]
+    pub bodies: Vec<BodyMarker>,
+}
+
+impl MarkerLayout {
+    /// The built-in layout: a 1.2 m × 0.9 m table, six 5 cm calibration markers (ids 0–5) near
+    /// its corners and long edges; the robot (id 10, marker at its centre), two objects (ids 11,
+    /// 12, markers off their centres) and a goal (id 20). Markers are 5 × 5 cm as in Lau et al.
+    pub fn default_table() -> MarkerLayout {
+        let side = 0.05;
+        let fixed = |id, x, y| FixedMarker {
+            id,
+            family: MarkerFamily::Tag36h11,
+            centre: [x, y],
+            heading: 0.0,
+            side,
+        };
+        let body = |name: &str, id, offset: [f64; 3]| BodyMarker {
+            body: name.into(),
+            id,
+            family: MarkerFamily::Tag36h11,
+            side,
+            offset,
+        };
+        MarkerLayout {
+            table: [1.2, 0.9],
+            calibration: vec![
+                fixed(0, 0.05, 0.05),
+                fixed(1, 1.15, 0.05),
+                fixed(2, 1.15, 0.85),
+                fixed(3, 0.05, 0.85),
+                fixed(4, 0.6, 0.05),
+                fixed(5, 0.6, 0.85),
+            ],
+            bodies: vec![
+                body("robot", 10, [0.0, 0.0, 0.0]),
+                body("object", 11, [0.02, -0.01, 0.0]),
+                body("object2", 12, [-0.03, 0.02, std::f64::consts::FRAC_PI_2]),
+                body("goal", 20, [0.0, 0.0, 0.0]),
+            ],
+        }
+    }
+
+    /// Read a layout from a TOML or JSON file (by extension; TOML otherwise) and check it.
+    pub fn load(path: &Path) -> Result<MarkerLayout, String> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let layout: MarkerLayout = if path.extension().is_some_and(|e| e == "json") {
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?
+        } else {
+            toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?
+        };
+        layout
+            .validate()
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(layout)
+    }
+
+    /// Check sizes are positive and finite and that no (family, id) is used twice.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.table.iter().all(|v| v.is_finite() && *v > 0.0) {
+            return Err(format!("table size {:?} must be positive", self.table));
+        }
+        let mut seen = std::collections::HashSet::new();
+        let fixed = self.calibration.iter().map(|m| {
+            (
+                m.family,
+                m.id,
+                m.side,
+                m.centre[0] + m.centre[1] + m.heading,
+            )
+        });
+        let bodies = self
+            .bodies
+            .iter()
+            .map(|b| (b.family, b.id, b.side, b.offset.iter().sum::<f64>()));
+        for (family, id, side, sum) in fixed.chain(bodies) {
+            if !(side.is_finite() && side > 0.0 && sum.is_finite()) {
+                return Err(format!(
+                    "marker {} {id}: side and positions must be finite, side positive",
+                    family.name()
+                ));
+            }
+            if !seen.insert((family, id)) {
+                return Err(format!("marker {} {id} is used twice", family.name()));
+            }
+        }
+        Ok(())
+    }
+
+    /// The body marker with this tag, if any.
+    pub fn body_marker(&self, family: MarkerFamily, id: u32) -> Option<&BodyMarker> {
+        self.bodies
+            .iter()
+            .find(|b| b.family == family && b.id == id)
+    }
+
+    /// The calibration marker with this tag, if any.
+    pub fn fixed_marker(&self, family: MarkerFamily, id: u32) -> Option<&FixedMarker> {
+        self.calibration
+            .iter()
+            .find(|b| b.family == family && b.id == id)
+    }
+
+    /// The families any marker uses.
+    pub fn families(&self) -> Vec<MarkerFamily> {
+        let mut f: Vec<MarkerFamily> = self
+            .calibration
+            .iter()
+            .map(|m| m.family)
+            .chain(self.bodies.iter().map(|b| b.family))
+            .collect();
+        f.sort_by_key(|f| f.name());
+        f.dedup();
+        if f.is_empty() {
+            f.push(MarkerFamily::Tag36h11);
+        }
+        f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn body_pose_inverts_placement() {
+        let b = BodyMarker {
+            body: "o".into(),
+            id: 1,
+            family: MarkerFamily::Tag36h11,
+            side: 0.05,
+            offset: [0.03, -0.02, 0.7],
+        };
+        let body = Pose::new(0.4, 0.3, -2.9);
+        let m = b.placement(&body);
+        let back = b.body_pose(&Pose::new(m.centre[0], m.centre[1], m.heading));
+        assert!((back.x - body.x).abs() < 1e-12 && (back.y - body.y).abs() < 1e-12);
+        assert!(wrap_angle(back.theta - body.theta).abs() < 1e-12);
+    }
+
+    #[test]
+    fn layout_round_trips_through_toml_and_rejects_duplicates() {
+        let l = MarkerLayout::default_table();
+        l.validate().unwrap();
+        let text = toml::to_string(&l).unwrap();
+        let back: MarkerLayout = toml::from_str(&text).unwrap();
+        assert_eq!(back, l);
+        let mut dup = l.clone();
+        dup.bodies[1].id = 0;
+        assert!(dup.validate().is_err());
+    }
+}

@@ -1,0 +1,360 @@
+//! The test cases of Ben-Shahar & Rivlin §V-A as presets: each test checks what the paper's
+//! figure shows, by comparing plans and re-costing them under the other presets' rules.
+
+use pushbot::planner::rearrange::cases::{CASES, load_scene, parse_scene};
+use pushbot::planner::rearrange::{
+    Config, Dir, Model, MoveKind, Plan, Problem, RestoreError, cost_map, replay_cost, restore,
+    solve,
+};
+
+fn plan_of(name: &str) -> (Problem, Model, Plan) {
+    let p = load_scene(name).unwrap();
+    let (model, _map, plan) = solve(&p).unwrap();
+    (p, model, plan.unwrap_or_else(|e| panic!("{name}: {e}")))
+}
+
+fn configs(plan: &Plan) -> Vec<Config> {
+    plan.steps.iter().map(|s| s.config.clone()).collect()
+}
+
+/// The movables pushed, stage by stage, with repeats of the same movable merged.
+fn push_runs(plan: &Plan) -> Vec<u8> {
+    let mut runs: Vec<u8> = Vec::new();
+    for s in &plan.steps {
+        if let MoveKind::Push { pushed } = s.step.kind
+            && runs.last() != Some(&pushed)
+        {
+            runs.push(pushed);
+        }
+    }
+    runs
+}
+
+/// Does any pushed movable arrive on a rough cell of problem `p`?
+fn pushes_through_rough(p: &Problem, plan: &Plan) -> bool {
+    plan.steps.iter().any(|s| match s.step.kind {
+        MoveKind::Push { pushed } => (0..p.movables.len()).any(|i| {
+            let pl = s.config.movables[i];
+            pushed & (1 << i) != 0
+                && p.movables[i]
+                    .cells_at(pl.o)
+                    .iter()
+                    .any(|&(x, y)| p.grid.get(pl.x + x, pl.y + y).is_some_and(|c| c.rough > 0))
+        }),
+        _ => false,
+    })
+}
+
+fn ends_at_goals(p: &Problem, plan: &Plan) -> bool {
+    let last = plan.steps.last().map(|s| &s.config).unwrap_or(&plan.start);
+    last.movables
+        .iter()
+        .zip(&p.goal_movables)
+        .all(|(m, g)| g.is_none_or(|g| g == *m))
+}
+
+#[test]
+fn a1_one_box_at_a_time_a2_two_at_once_is_cheaper() {
+    let (p1, _, a1) = plan_of("A1");
+    let (p2, _, a2) = plan_of("A2");
+    assert!(ends_at_goals(&p1, &a1) && ends_at_goals(&p2, &a2));
+    let double = |pl: &Plan| {
+        pl.steps
+            .iter()
+            .any(|s| matches!(s.step.kind, MoveKind::Push { pushed } if pushed.count_ones() == 2))
+    };
+    assert!(!double(&a1), "A1 may push only one box at a time");
+    assert!(double(&a2), "A2 should push both boxes together (Fig. 10)");
+    assert!(
+        a2.cost < a1.cost,
+        "A2 {} should beat A1 {}",
+        a2.cost,
+        a1.cost
+    );
+}
+
+#[test]
+fn a3_passability_changes_the_route() {
+    let (p3, m3, a3) = plan_of("A3");
+    let (_, _, a2) = plan_of("A2");
+    assert!(ends_at_goals(&p3, &a3));
+    assert!(
+        pushes_through_rough(&p3, &a2),
+        "A2's route crosses A3's rough region"
+    );
+    assert!(
+        !pushes_through_rough(&p3, &a3),
+        "A3 should push around the rough region (Fig. 11)"
+    );
+    let a2_under_a3 =
+        replay_cost(&m3, &a2.start, &configs(&a2)).expect("A2's plan is admissible in A3");
+    assert!(
+        a2_under_a3 > a3.cost,
+        "A2's route costs {a2_under_a3} under A3's metric, A3's {}",
+        a3.cost
+    );
+}
+
+#[test]
+fn a4_distance_limit_makes_the_robot_fetch_the_second_box() {
+    let (p4, _, a4) = plan_of("A4");
+    let (_, _, a1) = plan_of("A1");
+    assert!(ends_at_goals(&p4, &a4));
+    let limit = p4.rules.distance_limit.unwrap() as i32;
+    for s in &a4.steps {
+        let pushed = match s.step.kind {
+            MoveKind::Push { pushed } => pushed,
+            _ => 0,
+        };
+        for (i, m) in s.config.movables.iter().enumerate() {
+            if pushed & (1 << i) == 0 {
+                let d = (m.x - s.config.robot.0).abs() + (m.y - s.config.robot.1).abs();
+                assert!(d <= limit, "robot {d} from a box it is not pushing");
+            }
+        }
+    }
+    assert_eq!(
+        push_runs(&a1).len(),
+        2,
+        "without a limit each box is pushed in one go"
+    );
+    assert!(
+        push_runs(&a4).len() >= 3,
+        "with the limit the robot alternates between the boxes (Fig. 12)"
+    );
+    assert!(a4.cost >= a1.cost);
+}
+
+#[test]
+fn b1_exchange_needs_an_intermediate_placement() {
+    let (p, _, b1) = plan_of("B1");
+    assert!(ends_at_goals(&p, &b1));
+    let row = p.start.movables[0].y;
+    assert!(
+        b1.steps
+            .iter()
+            .any(|s| s.config.movables.iter().any(|m| m.y != row)),
+        "one box must leave the line the two share (Fig. 13)"
+    );
+}
+
+#[test]
+fn b2_rough_region_changes_the_exchange() {
+    let (_, _, b1) = plan_of("B1");
+    let (p2, m2, b2) = plan_of("B2");
+    assert!(ends_at_goals(&p2, &b2));
+    assert!(
+        pushes_through_rough(&p2, &b1),
+        "B1 uses the region that B2 makes rough"
+    );
+    assert!(
+        !pushes_through_rough(&p2, &b2),
+        "B2 avoids the rough region (Fig. 14)"
+    );
+    let b1_under_b2 =
+        replay_cost(&m2, &b1.start, &configs(&b1)).expect("B1's plan is admissible in B2");
+    assert!(b1_under_b2 > b2.cost);
+}
+
+#[test]
+fn c1_small_robot_uses_pushes_the_large_c2_cannot() {
+    let (p1, _, c1) = plan_of("C1");
+    let (p2, m2, c2) = plan_of("C2");
+    assert!(ends_at_goals(&p1, &c1) && ends_at_goals(&p2, &c2));
+    assert!(c1.cost < c2.cost, "C1 {} vs C2 {}", c1.cost, c2.cost);
+    // C1 pushes the movable south where it starts ...
+    let start_u = p1.start.movables[0];
+    let mut before = p1.start.clone();
+    let mut c1_south_at_start = false;
+    for s in &c1.steps {
+        if s.step.kind != MoveKind::Transit && s.step.dir == Dir::S && before.movables[0] == start_u
+        {
+            c1_south_at_start = true;
+        }
+        before = s.config.clone();
+    }
+    assert!(
+        c1_south_at_start,
+        "the small robot pushes south from the start (Fig. 16)"
+    );
+    // ... which no placement of the large robot can do (Fig. 17).
+    let mut nb = Vec::new();
+    for r in 0..m2.robot.len() {
+        let rp = m2.robot.place[r as usize];
+        let c = Config {
+            robot: (rp.x, rp.y),
+            heading: Dir::E,
+            pushing: false,
+            movables: vec![start_u],
+        };
+        if let Some(idx) = m2.pack(&c) {
+            m2.neighbours(idx, &mut nb);
+            assert!(!nb.iter().any(|s| s.step_is_push() && s.dir == Dir::S));
+        }
+    }
+    let first_push = c2
+        .steps
+        .iter()
+        .find(|s| s.step.kind != MoveKind::Transit)
+        .unwrap();
+    assert_ne!(
+        first_push.step.dir,
+        Dir::S,
+        "the large robot must first move the movable elsewhere"
+    );
+}
+
+trait IsPush {
+    fn step_is_push(&self) -> bool;
+}
+impl IsPush for pushbot::planner::rearrange::Step {
+    fn step_is_push(&self) -> bool {
+        self.kind != MoveKind::Transit
+    }
+}
+
+#[test]
+fn d1_rotational_pushes_in_clutter() {
+    let (p, _, d1) = plan_of("D1");
+    assert!(ends_at_goals(&p, &d1));
+    assert!(
+        d1.steps
+            .iter()
+            .any(|s| matches!(s.step.kind, MoveKind::Rotate { .. }))
+    );
+    let mut no_rot = p.clone();
+    no_rot.rules.rotations = false;
+    let (_, _, plan) = solve(&no_rot).unwrap();
+    assert_eq!(
+        plan.unwrap_err(),
+        RestoreError::NoPushingPath,
+        "without rotations D1 has no solution (§V-A)"
+    );
+}
+
+#[test]
+fn the_map_is_reused_for_new_starts() {
+    let p = load_scene("B1").unwrap();
+    let model = Model::new(&p).unwrap();
+    let map = cost_map(&model).unwrap();
+    let mut solved = 0;
+    for idx in (0..model.n_states as u32).step_by(97) {
+        match restore(&model, &map, idx) {
+            Ok(plan) => {
+                solved += 1;
+                assert_eq!(Some(plan.cost), map.get(idx));
+                assert_eq!(
+                    replay_cost(&model, &plan.start, &configs(&plan)),
+                    Some(plan.cost)
+                );
+            }
+            Err(e) => assert!(map.get(idx).is_none(), "{e}"),
+        }
+    }
+    assert!(solved > 10);
+}
+
+#[test]
+fn every_preset_parses_and_has_a_plan() {
+    for (name, _, _) in CASES {
+        let (p, _, plan) = plan_of(name);
+        assert!(ends_at_goals(&p, &plan), "{name}");
+    }
+}
+
+#[test]
+fn malformed_scenes_name_line_and_field() {
+    let base = "map = \"\"\"\n...\n...\n\"\"\"\n[robot]\nat = [0, 0]\n";
+    let e = parse_scene(&format!("{base}[[movable]]\nname = \"a\"\n"), "t")
+        .unwrap_err()
+        .0;
+    assert!(e.contains("line") && e.contains("at"), "{e}");
+    let e = parse_scene(&format!("{base}[[movable]]\nname = \"a\"\nat = [1, 1]\npush = [{{ point = [0, 1], dir = \"Q\" }}]\n"), "t")
+        .unwrap_err()
+        .0;
+    assert!(e.contains("line 10") && e.contains("push.dir"), "{e}");
+    let e = parse_scene("map = \"\"\"\n..\n.?\n\"\"\"\n[robot]\nat = [0, 0]\n", "t")
+        .unwrap_err()
+        .0;
+    assert!(
+        e.contains("line 1") && e.contains("`map`") && e.contains("row 2 column 2"),
+        "{e}"
+    );
+    let e = parse_scene(
+        &format!("{base}[[movable]]\nname = \"a\"\nat = [5, 1]\n"),
+        "t",
+    )
+    .unwrap_err()
+    .0;
+    assert!(e.contains("line 9") && e.contains("movable `a`.at"), "{e}");
+    let e = parse_scene(&format!("{base}[rules]\nmax_pushd = 2\n"), "t")
+        .unwrap_err()
+        .0;
+    assert!(e.contains("line 8") && e.contains("max_pushd"), "{e}");
+}
+
+fn pushbot(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pushbot"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn cli_plan_rearrange_exit_codes_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("d1.svg");
+    let (code, out, _) = pushbot(&[
+        "plan",
+        "rearrange",
+        "--scene",
+        "D1",
+        "--json",
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["found"], true);
+    for key in [
+        "cost",
+        "steps",
+        "pushes",
+        "states_mapped",
+        "map_ms",
+        "restore_ms",
+        "peak_kib",
+        "plan",
+    ] {
+        assert!(!j[key].is_null(), "{key} missing in {out}");
+    }
+    assert_eq!(
+        j["plan"].as_array().unwrap().len() as u64,
+        j["steps"].as_u64().unwrap()
+    );
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+    // a box in a corner cannot be pushed out: no pushing path, exit 1
+    let stuck = dir.path().join("stuck.toml");
+    std::fs::write(&stuck, "map = \"\"\"\n....\n....\n\"\"\"\n[robot]\nat = [3, 1]\n[[movable]]\nname = \"a\"\nat = [0, 0]\ngoal = [2, 1]\n").unwrap();
+    let (code, out, _) = pushbot(&[
+        "plan",
+        "rearrange",
+        "--scene",
+        stuck.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("\"found\":false"));
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "map = 3\n").unwrap();
+    let (code, _, err) = pushbot(&["plan", "rearrange", "--scene", bad.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("map"), "{err}");
+    let (code, _, _) = pushbot(&["plan", "rearrange", "--scene", "no-such-scene"]);
+    assert_eq!(code, 2);
+}

@@ -1,0 +1,273 @@
+//! Vision against the simulated camera's ground truth: detection, calibration and pose accuracy
+//! on a few hundred rendered 960×720 frames with noise and mild blur; frame sources; CLI.
+
+use pushbot::vision::apriltag::{AprilTagC, AprilTagCConfig};
+use pushbot::vision::detect::Detector;
+use pushbot::vision::folder::FolderSource;
+#[cfg(feature = "kornia")]
+use pushbot::vision::kornia::{KorniaConfig, KorniaDetector};
+use pushbot::vision::layout::MarkerLayout;
+use pushbot::vision::measure;
+use pushbot::vision::simsocket::SimSocketSource;
+use pushbot::vision::source::{FrameSource, SourceError, open_source};
+use pushbot::vision::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
+use pushbot_sim::camera::CameraFrame;
+use pushbot_sim::camera::server::CameraServer;
+
+/// Issue 5's acceptance: on 300 rendered frames, body position error median ≤ 1.5 mm and 99th
+/// percentile ≤ 4 mm, heading median ≤ 0.5°, ≥ 99.5 % of fully visible markers found, no
+/// wrong ids. The camera is calibrated from the first frames' calibration markers, as
+/// `pushbot calibrate` does.
+#[test]
+fn accuracy_on_rendered_frames() {
+    let layout = MarkerLayout::default_table();
+    let frames = synth::frames(&layout, 300, 42, &SynthParams::default()).unwrap();
+    let mut det = AprilTagC::new(&layout.families(), &AprilTagCConfig::default()).unwrap();
+    let dets: Vec<_> = frames
+        .iter()
+        .map(|f| det.detect(&f.frame).unwrap())
+        .collect();
+    let cal = synth::calibrate(&dets[..5], &layout, [960, 720]).unwrap();
+    assert!(cal.rms_px < 0.2, "calibration RMS {} px", cal.rms_px);
+    let mut score = DetectionScore::default();
+    let mut poses = PoseScore::default();
+    for (d, f) in dets.iter().zip(&frames) {
+        score.add(d, &f.markers);
+        poses.add(&measure(d, &cal, &layout), &f.bodies);
+    }
+    let (med, p99) = (quantile(&poses.pos_mm, 0.5), quantile(&poses.pos_mm, 0.99));
+    let hmed = quantile(&poses.heading_deg, 0.5);
+    eprintln!(
+        "found {}/{} wrong {} corner rms {:.3} px bias {:?}; position median {med:.3} mm p99 {p99:.3} mm; heading median {hmed:.3}° p99 {:.3}°",
+        score.found,
+        score.visible,
+        score.wrong_ids,
+        score.corner_rms(),
+        score.corner_bias,
+        quantile(&poses.heading_deg, 0.99)
+    );
+    assert_eq!(
+        score.visible,
+        300 * 10,
+        "every marker is drawn fully visible"
+    );
+    assert!(
+        score.rate() >= 0.995,
+        "found {}/{}",
+        score.found,
+        score.visible
+    );
+    assert_eq!(score.wrong_ids, 0);
+    assert!(med <= 1.5, "position median {med} mm");
+    assert!(p99 <= 4.0, "position p99 {p99} mm");
+    assert!(hmed <= 0.5, "heading median {hmed}°");
+}
+
+/// The kornia candidate reads the same frames with the same corner convention (a wrong corner
+/// order would show as a 90° heading error or a corner error of tens of pixels).
+#[cfg(feature = "kornia")]
+#[test]
+fn kornia_candidate_agrees_on_corners() {
+    let layout = MarkerLayout::default_table();
+    let frames = synth::frames(&layout, 10, 7, &SynthParams::default()).unwrap();
+    let mut det = KorniaDetector::new(
+        &layout.families(),
+        &KorniaConfig {
+            threshold_split: Some(0.5),
+            downscale: None,
+        },
+    )
+    .unwrap();
+    let mut score = DetectionScore::default();
+    for f in &frames {
+        score.add(&det.detect(&f.frame).unwrap(), &f.markers);
+    }
+    eprintln!(
+        "kornia: found {}/{}, corner rms {:.3} px, bias {:?}",
+        score.found,
+        score.visible,
+        score.corner_rms(),
+        score.corner_bias
+    );
+    assert!(
+        score.rate() > 0.8,
+        "found {}/{}",
+        score.found,
+        score.visible
+    );
+    assert!(
+        score.corner_rms() < 1.0,
+        "corner rms {}",
+        score.corner_rms()
+    );
+    assert_eq!(score.wrong_ids, 0);
+}
+
+fn rendered(n: usize) -> Vec<CameraFrame> {
+    let layout = MarkerLayout::default_table();
+    let frames = synth::frames(&layout, n, 3, &SynthParams::default()).unwrap();
+    frames
+        .into_iter()
+        .map(|f| CameraFrame {
+            seq: f.frame.seq,
+            time: 10.0 + f.frame.time,
+            width: f.frame.width,
+            height: f.frame.height,
+            pixels: f.frame.pixels,
+            truth: f.markers,
+        })
+        .collect()
+}
+
+#[test]
+fn folder_source_reads_rendered_pngs() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = rendered(3);
+    for f in &frames {
+        f.write_png(dir.path()).unwrap();
+    }
+    let mut src = FolderSource::open(dir.path(), 30.0).unwrap();
+    for f in &frames {
+        let got = src.next_frame().unwrap().unwrap();
+        assert_eq!((got.width, got.height), (960, 720));
+        assert_eq!(got.pixels, f.pixels, "PNG round trip is lossless");
+        assert!((got.time - f.time).abs() < 1e-12, "time from the sidecar");
+    }
+    assert!(src.next_frame().unwrap().is_none());
+    let empty = tempfile::tempdir().unwrap();
+    assert!(matches!(
+        FolderSource::open(empty.path(), 30.0),
+        Err(SourceError::BadSource(_))
+    ));
+}
+
+#[test]
+fn sim_socket_source_receives_frames() {
+    let server = CameraServer::bind("127.0.0.1:0").unwrap();
+    let mut src = SimSocketSource::connect(&server.local_addr().to_string()).unwrap();
+    for _ in 0..400 {
+        if server.clients() == 1 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let frames = rendered(2);
+    for f in &frames {
+        assert_eq!(server.publish(f), 1);
+    }
+    for f in &frames {
+        let got = src.next_frame().unwrap().unwrap();
+        assert_eq!((got.seq, got.pixels.len()), (f.seq, 960 * 720));
+        assert!((got.time - f.time).abs() < 1e-12);
+        assert_eq!(got.pixels, f.pixels);
+        assert_eq!(src.last_truth.len(), f.truth.len());
+    }
+    drop(server);
+}
+
+#[test]
+fn missing_v4l2_device_is_a_clear_bad_input() {
+    let err = open_source("/dev/video-pushbot-missing", 30.0)
+        .err()
+        .expect("no such device");
+    match err {
+        SourceError::BadSource(msg) => assert!(msg.contains("does not exist"), "{msg}"),
+        other => panic!("expected BadSource, got {other:?}"),
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pushbot"))
+        .args(["track", "--camera", "/dev/video-pushbot-missing", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
+}
+
+/// `pushbot calibrate` then `pushbot track --json` on a folder of rendered frames.
+#[test]
+fn cli_calibrate_and_track_on_a_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = rendered(4);
+    for f in &frames {
+        f.write_png(dir.path()).unwrap();
+    }
+    let cal = dir.path().join("cal.json");
+    let bin = env!("CARGO_BIN_EXE_pushbot");
+    let cam = dir.path().to_str().unwrap();
+    let out = std::process::Command::new(bin)
+        .args([
+            "calibrate",
+            "--camera",
+            cam,
+            "--out",
+            cal.to_str().unwrap(),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["rms_px"].as_f64().unwrap() < 0.2);
+    let out = std::process::Command::new(bin)
+        .args([
+            "track",
+            "--camera",
+            cam,
+            "--calibration",
+            cal.to_str().unwrap(),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 4);
+    let truth = synth::frames(
+        &MarkerLayout::default_table(),
+        4,
+        3,
+        &SynthParams::default(),
+    )
+    .unwrap();
+    for (l, f) in lines.iter().zip(&truth) {
+        assert!((l["time"].as_f64().unwrap() - 10.0 - f.frame.time).abs() < 1e-9);
+        let robot = l["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|b| b["id"] == "robot")
+            .unwrap();
+        let (name, pose) = &f.bodies[0];
+        assert_eq!(name, "robot");
+        // Each frame places the robot anew: the first frame is exact, later ones are followed
+        // or (after the filter's gate rejects a jump) reported as unseen; check the first.
+        if l["seq"] == 0 {
+            assert_eq!(robot["seen"], true);
+            assert!((robot["x"].as_f64().unwrap() - pose.x).abs() < 0.003);
+            assert!((robot["y"].as_f64().unwrap() - pose.y).abs() < 0.003);
+        }
+    }
+    // A missing calibration file is bad input.
+    let out = std::process::Command::new(bin)
+        .args([
+            "track",
+            "--camera",
+            cam,
+            "--calibration",
+            "/nonexistent/cal.json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}

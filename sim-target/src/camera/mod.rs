@@ -1,0 +1,372 @@
+//! The simulated overhead camera (Lau et al. §IV: a ceiling camera sees the table from above, with
+//! markers on the robot, the objects and the goals; 960×720 at 30 fps).
+//!
+//! [`Camera::capture`] renders one grayscale frame of the table at a simulated time: polygons for
+//! the table and the bodies, AprilTag markers (tag36h11 by default) with a white quiet zone, then
+//! blur, exposure and seeded noise. Every frame carries its ground truth: each marker's pose on
+//! the table and its exact corners in pixels (pixel centres at `i + 0.5`). Frames can be written
+//! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
+
+pub mod families;
+pub mod render;
+pub mod server;
+
+use std::path::{Path, PathBuf};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+pub use render::{Homography, MarkerFamily, MarkerPlacement, Polygon, TagCodes};
+
+/// Where the camera looks: image size and the table-plane → pixel homography.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CameraModel {
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Table metres → pixel coordinates (pixel centres at `i + 0.5`).
+    pub table_to_pixel: Homography,
+}
+
+impl CameraModel {
+    /// A camera straight above the centre of a `table[0] × table[1]` m table, the table filling
+    /// the image but for `margin_px` on its tighter side; table +y is image up.
+    pub fn overhead(table: [f64; 2], width: u32, height: u32, margin_px: f64) -> CameraModel {
+        let s = ((width as f64 - 2.0 * margin_px) / table[0])
+            .min((height as f64 - 2.0 * margin_px) / table[1]);
+        let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
+        CameraModel {
+            width,
+            height,
+            table_to_pixel: Homography([
+                [s, 0.0, cx - s * table[0] / 2.0],
+                [0.0, -s, cy + s * table[1] / 2.0],
+                [0.0, 0.0, 1.0],
+            ]),
+        }
+    }
+
+    /// The same camera slightly tilted: a perspective term `(px, py)` per pixel about the image
+    /// centre (1e-5 is a mild tilt).
+    pub fn tilted(self, px: f64, py: f64) -> CameraModel {
+        let (cx, cy) = (self.width as f64 / 2.0, self.height as f64 / 2.0);
+        let t = Homography([[1.0, 0.0, cx], [0.0, 1.0, cy], [0.0, 0.0, 1.0]]);
+        let t_inv = Homography([[1.0, 0.0, -cx], [0.0, 1.0, -cy], [0.0, 0.0, 1.0]]);
+        let p = Homography([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [px, py, 1.0]]);
+        CameraModel {
+            table_to_pixel: t.compose(&p).compose(&t_inv).compose(&self.table_to_pixel),
+            ..self
+        }
+    }
+}
+
+/// Optics and sensor of the simulated camera.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Imaging {
+    /// Gaussian blur, standard deviation in pixels (0.6–1.0 is mild).
+    pub blur_sigma_px: f64,
+    /// Sensor noise, standard deviation in gray levels.
+    pub noise_sigma: f64,
+    /// Exposure multiplier (1 nominal).
+    pub exposure: f64,
+    /// Gray level of a perfectly black surface.
+    pub black_level: f64,
+    /// Gray level of a perfectly white surface at exposure 1.
+    pub white_level: f64,
+    /// Reflectance of the table top.
+    pub table_shade: f64,
+    /// Reflectance of what is around the table.
+    pub floor_shade: f64,
+    /// Reflectance of the markers' black and white.
+    pub ink: [f64; 2],
+    /// White quiet zone around each tag beyond its own white border, in tag cells.
+    pub quiet_cells: f64,
+    /// Supersampling per axis for markers, and sub-rows per pixel row for polygons.
+    pub supersample: usize,
+}
+
+impl Default for Imaging {
+    fn default() -> Self {
+        Imaging {
+            blur_sigma_px: 0.7,
+            noise_sigma: 3.0,
+            exposure: 1.0,
+            black_level: 20.0,
+            white_level: 235.0,
+            table_shade: 0.55,
+            floor_shade: 0.2,
+            ink: [0.04, 0.95],
+            quiet_cells: 1.0,
+            supersample: 8,
+        }
+    }
+}
+
+/// Everything that makes a camera: where it looks, its optics, its frame rate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CameraConfig {
+    /// Geometry.
+    pub model: CameraModel,
+    /// Optics and sensor.
+    pub imaging: Imaging,
+    /// Frames per second of simulated time.
+    pub fps: f64,
+    /// Table size (metres), drawn as a rectangle from (0, 0).
+    pub table: [f64; 2],
+}
+
+impl CameraConfig {
+    /// 960×720 at 30 fps over a `table` (metres) with a 16 px margin, default optics.
+    pub fn default_for_table(table: [f64; 2]) -> CameraConfig {
+        CameraConfig {
+            model: CameraModel::overhead(table, 960, 720, 16.0),
+            imaging: Imaging::default(),
+            fps: 30.0,
+            table,
+        }
+    }
+}
+
+/// Ground truth of one marker in one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MarkerTruth {
+    /// The placement drawn.
+    pub marker: MarkerPlacement,
+    /// Corners of the black square in pixels: printed bottom-left, bottom-right, top-right,
+    /// top-left.
+    pub corners_px: [[f64; 2]; 4],
+    /// Centre in pixels.
+    pub centre_px: [f64; 2],
+    /// Whether the whole marker, quiet zone included, lies inside the image.
+    pub fully_visible: bool,
+}
+
+/// One frame: 8-bit grayscale pixels row-major plus ground truth.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CameraFrame {
+    /// Frame number from 0.
+    pub seq: u64,
+    /// Simulated time of exposure, seconds.
+    pub time: f64,
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// Gray levels, row-major, `width × height` bytes.
+    #[serde(skip)]
+    pub pixels: Vec<u8>,
+    /// Ground truth of every marker drawn.
+    pub truth: Vec<MarkerTruth>,
+}
+
+/// Why a frame could not be made or written.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraError {
+    /// A placement or the configuration is not drawable.
+    #[error("camera: {0}")]
+    Invalid(String),
+    /// Writing a file failed.
+    #[error("camera: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+impl CameraFrame {
+    /// Write the frame as `frame-NNNNNN.png` and its ground truth (with `time`) as
+    /// `frame-NNNNNN.json` into `dir`; returns the PNG's path.
+    pub fn write_png(&self, dir: &Path) -> Result<PathBuf, CameraError> {
+        std::fs::create_dir_all(dir)?;
+        let png = dir.join(format!("frame-{:06}.png", self.seq));
+        let img = image::GrayImage::from_raw(self.width, self.height, self.pixels.clone())
+            .ok_or_else(|| {
+                CameraError::Invalid("pixel buffer size does not match the frame size".into())
+            })?;
+        img.save(&png)
+            .map_err(|e| CameraError::Io(std::io::Error::other(e)))?;
+        let json = serde_json::to_string(self).map_err(|e| CameraError::Invalid(e.to_string()))?;
+        std::fs::write(dir.join(format!("frame-{:06}.json", self.seq)), json)?;
+        Ok(png)
+    }
+}
+
+/// The simulated camera: renders frames of the table in simulated time with seeded noise.
+#[derive(Debug, Clone)]
+pub struct Camera {
+    config: CameraConfig,
+    codes: TagCodes,
+    rng: ChaCha8Rng,
+    seq: u64,
+}
+
+impl Camera {
+    /// A camera with its own noise stream from `seed`.
+    pub fn new(config: CameraConfig, seed: u64) -> Result<Camera, CameraError> {
+        if config.model.table_to_pixel.inverse().is_none() {
+            return Err(CameraError::Invalid(
+                "table→pixel homography is singular".into(),
+            ));
+        }
+        if !(config.fps.is_finite() && config.fps > 0.0)
+            || config.model.width == 0
+            || config.model.height == 0
+        {
+            return Err(CameraError::Invalid(
+                "frame rate and image size must be positive".into(),
+            ));
+        }
+        Ok(Camera {
+            config,
+            codes: TagCodes::new().map_err(CameraError::Invalid)?,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            seq: 0,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &CameraConfig {
+        &self.config
+    }
+
+    /// Seconds between frames.
+    pub fn period(&self) -> f64 {
+        1.0 / self.config.fps
+    }
+
+    /// Render the next frame at simulated `time`: table, `polygons` in order, then `markers`.
+    pub fn capture(
+        &mut self,
+        time: f64,
+        polygons: &[Polygon],
+        markers: &[MarkerPlacement],
+    ) -> Result<CameraFrame, CameraError> {
+        let cfg = &self.config;
+        let im = &cfg.imaging;
+        let (w, h) = (cfg.model.width as usize, cfg.model.height as usize);
+        let h_tp = cfg.model.table_to_pixel;
+        let mut canvas = render::Canvas::new(w, h, h_tp, im.floor_shade)
+            .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
+        let n = im.supersample.max(1);
+        let [tw, th] = cfg.table;
+        let table = Polygon {
+            points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]],
+            shade: im.table_shade,
+        };
+        canvas.polygon(&table, n);
+        for p in polygons {
+            canvas.polygon(p, n);
+        }
+        let mut truth = Vec::with_capacity(markers.len());
+        for m in markers {
+            canvas
+                .marker(&self.codes, m, im.quiet_cells, n, im.ink[0], im.ink[1])
+                .map_err(CameraError::Invalid)?;
+            let px = |p: [f64; 2]| h_tp.apply(p).unwrap_or([f64::NAN; 2]);
+            let (_, tw, wab) = self
+                .codes
+                .pattern(m.family, m.id)
+                .ok_or_else(|| CameraError::Invalid("bad id".into()))?;
+            let outer_side = m.side * (tw as f64 + 2.0 * im.quiet_cells) / wab as f64;
+            let outer = MarkerPlacement {
+                side: outer_side,
+                ..*m
+            };
+            let fully_visible = outer.corners().iter().all(|&p| {
+                let q = px(p);
+                q[0] >= 1.0 && q[1] >= 1.0 && q[0] <= w as f64 - 1.0 && q[1] <= h as f64 - 1.0
+            });
+            truth.push(MarkerTruth {
+                marker: *m,
+                corners_px: m.corners().map(px),
+                centre_px: px(m.centre),
+                fully_visible,
+            });
+        }
+        render::gaussian_blur(&mut canvas.data, w, h, im.blur_sigma_px);
+        let pixels = render::develop(
+            &canvas.data,
+            im.exposure,
+            im.black_level,
+            im.white_level,
+            im.noise_sigma,
+            &mut self.rng,
+        );
+        let frame = CameraFrame {
+            seq: self.seq,
+            time,
+            width: cfg.model.width,
+            height: cfg.model.height,
+            pixels,
+            truth,
+        };
+        self.seq += 1;
+        Ok(frame)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overhead_maps_table_corners_inside_image() {
+        let m = CameraModel::overhead([1.2, 0.9], 960, 720, 16.0);
+        let a = m.table_to_pixel.apply([0.0, 0.9]).unwrap();
+        let b = m.table_to_pixel.apply([1.2, 0.0]).unwrap();
+        assert!(
+            a[0] >= 15.9 && a[1] >= 15.9 && b[0] <= 944.1 && b[1] <= 704.1,
+            "{a:?} {b:?}"
+        );
+        let t = m.tilted(1e-5, -1e-5);
+        let c = t.table_to_pixel.apply([0.6, 0.45]).unwrap();
+        assert!(
+            (c[0] - 480.0).abs() < 1e-9 && (c[1] - 360.0).abs() < 1e-9,
+            "centre stays: {c:?}"
+        );
+    }
+
+    #[test]
+    fn frames_are_seeded_and_carry_truth() {
+        let cfg = CameraConfig::default_for_table([1.2, 0.9]);
+        let m = MarkerPlacement {
+            id: 7,
+            family: MarkerFamily::Tag36h11,
+            centre: [0.6, 0.45],
+            heading: 0.3,
+            side: 0.05,
+        };
+        let a = Camera::new(cfg, 5)
+            .unwrap()
+            .capture(0.0, &[], &[m])
+            .unwrap();
+        let b = Camera::new(cfg, 5)
+            .unwrap()
+            .capture(0.0, &[], &[m])
+            .unwrap();
+        let c = Camera::new(cfg, 6)
+            .unwrap()
+            .capture(0.0, &[], &[m])
+            .unwrap();
+        assert_eq!(a.pixels, b.pixels);
+        assert_ne!(a.pixels, c.pixels);
+        assert_eq!(a.pixels.len(), 960 * 720);
+        assert!(a.truth[0].fully_visible);
+        let centre = a.truth[0].centre_px;
+        assert!((centre[0] - 480.0).abs() < 1e-9 && (centre[1] - 360.0).abs() < 1e-9);
+        // The pixel at the tag's centre-left black ring is dark, the table is mid-gray.
+        let g = |x: f64, y: f64| a.pixels[y as usize * 960 + x as usize];
+        assert!(g(10.0, 360.0) < 80, "floor dark");
+        assert!(
+            (100..160).contains(&g(300.0, 360.0)),
+            "table mid-gray: {}",
+            g(300.0, 360.0)
+        );
+        let bad = MarkerPlacement { id: 900, ..m };
+        assert!(
+            Camera::new(cfg, 5)
+                .unwrap()
+                .capture(0.0, &[], &[bad])
+                .is_err()
+        );
+    }
+}

@@ -1,0 +1,545 @@
+//! Anti-aliased rendering of the table seen from above: polygons (table, bodies) and AprilTag
+//! markers drawn by supersampling each pixel (pixel centres at `i + 0.5`), then the optics and
+//! the sensor: Gaussian blur, exposure, seeded noise, 8-bit quantisation.
+//!
+//! Marker bit patterns come from the AprilTag library's family data ([`super::families`]), laid
+//! out exactly as its `apriltag_to_image` does.
+
+use super::families::{FamilyData, TAG25H9, TAG36H11};
+use rand::Rng;
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+
+/// A planar projective map `p ↦ H p` in homogeneous coordinates (row-major 3×3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Homography(pub [[f64; 3]; 3]);
+
+impl Homography {
+    /// The identity map.
+    pub const IDENTITY: Homography =
+        Homography([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+
+    /// Map a point; `None` when it maps to infinity (or behind the camera).
+    pub fn apply(&self, p: [f64; 2]) -> Option<[f64; 2]> {
+        let h = &self.0;
+        let w = h[2][0] * p[0] + h[2][1] * p[1] + h[2][2];
+        if w.abs() < 1e-12 || !w.is_finite() {
+            return None;
+        }
+        let x = (h[0][0] * p[0] + h[0][1] * p[1] + h[0][2]) / w;
+        let y = (h[1][0] * p[0] + h[1][1] * p[1] + h[1][2]) / w;
+        (x.is_finite() && y.is_finite()).then_some([x, y])
+    }
+
+    /// The product `self · other` (apply `other` first).
+    pub fn compose(&self, other: &Homography) -> Homography {
+        let (a, b) = (&self.0, &other.0);
+        let mut m = [[0.0; 3]; 3];
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+            }
+        }
+        Homography(m)
+    }
+
+    /// The inverse map, `None` if singular.
+    pub fn inverse(&self) -> Option<Homography> {
+        let m = &self.0;
+        let c = |r0: usize, r1: usize, c0: usize, c1: usize| {
+            m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+        };
+        let det = m[0][0] * c(1, 2, 1, 2) - m[0][1] * c(1, 2, 0, 2) + m[0][2] * c(1, 2, 0, 1);
+        if det.abs() < 1e-300 || !det.is_finite() {
+            return None;
+        }
+        let inv = [
+            [
+                c(1, 2, 1, 2) / det,
+                -c(0, 2, 1, 2) / det,
+                c(0, 1, 1, 2) / det,
+            ],
+            [
+                -c(1, 2, 0, 2) / det,
+                c(0, 2, 0, 2) / det,
+                -c(0, 1, 0, 2) / det,
+            ],
+            [
+                c(1, 2, 0, 1) / det,
+                -c(0, 2, 0, 1) / det,
+                c(0, 1, 0, 1) / det,
+            ],
+        ];
+        Some(Homography(inv))
+    }
+}
+
+/// The AprilTag families the camera can draw.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MarkerFamily {
+    /// tag36h11: the default (587 ids, minimum Hamming distance 11).
+    #[default]
+    Tag36h11,
+    /// tag25h9: for small markers (35 ids, 7×7 black square).
+    Tag25h9,
+}
+
+impl MarkerFamily {
+    /// The family's name as the AprilTag library spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MarkerFamily::Tag36h11 => "tag36h11",
+            MarkerFamily::Tag25h9 => "tag25h9",
+        }
+    }
+}
+
+/// One marker on the table: its family and id, where its centre is (table metres), which way its
+/// printed "right" points (radians from the table's +x, counter-clockwise) and the side of its
+/// black square (metres).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MarkerPlacement {
+    /// Tag id within the family.
+    pub id: u32,
+    /// Tag family.
+    pub family: MarkerFamily,
+    /// Centre on the table plane, metres.
+    pub centre: [f64; 2],
+    /// Heading of the printed tag's +x axis, radians CCW from the table's +x.
+    pub heading: f64,
+    /// Side of the black square, metres.
+    pub side: f64,
+}
+
+impl MarkerPlacement {
+    /// Corners of the black square on the table in the printed tag's order bottom-left,
+    /// bottom-right, top-right, top-left (counter-clockwise seen from above).
+    pub fn corners(&self) -> [[f64; 2]; 4] {
+        let h = self.side / 2.0;
+        let (s, c) = self.heading.sin_cos();
+        [[-h, -h], [h, -h], [h, h], [-h, h]].map(|[a, b]| {
+            [
+                self.centre[0] + c * a - s * b,
+                self.centre[1] + s * a + c * b,
+            ]
+        })
+    }
+}
+
+/// A filled polygon on the table plane (table metres) with its reflectance in `[0, 1]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Polygon {
+    /// Vertices in order (either winding); the even-odd rule decides inside.
+    pub points: Vec<[f64; 2]>,
+    /// Reflectance: 0 black, 1 white.
+    pub shade: f64,
+}
+
+/// Bit patterns of the supported families.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TagCodes;
+
+impl TagCodes {
+    /// The family tables.
+    pub fn new() -> Result<TagCodes, String> {
+        Ok(TagCodes)
+    }
+
+    fn family(&self, f: MarkerFamily) -> &'static FamilyData {
+        match f {
+            MarkerFamily::Tag36h11 => &TAG36H11,
+            MarkerFamily::Tag25h9 => &TAG25H9,
+        }
+    }
+
+    /// Number of ids in a family.
+    pub fn len(&self, f: MarkerFamily) -> usize {
+        self.family(f).codes.len()
+    }
+
+    /// Whether a family has no ids (never, for the built-in ones).
+    pub fn is_empty(&self, f: MarkerFamily) -> bool {
+        self.len(f) == 0
+    }
+
+    /// The tag's image, `total_width`² cells row-major (row 0 at the top of the printed tag),
+    /// `true` = white, and the width of its black square in cells; as `apriltag_to_image`.
+    pub fn pattern(&self, f: MarkerFamily, id: u32) -> Option<(Vec<bool>, usize, usize)> {
+        let fam = self.family(f);
+        let code = *fam.codes.get(id as usize)?;
+        let tw = fam.total_width;
+        let mut im = vec![false; tw * tw];
+        let wbw = fam.width_at_border + if fam.reversed_border { 0 } else { 2 };
+        let wbs = (tw - wbw) / 2;
+        for i in 0..wbw.saturating_sub(1) {
+            im[wbs * tw + wbs + i] = true;
+            im[(wbs + i) * tw + tw - 1 - wbs] = true;
+            im[(tw - 1 - wbs) * tw + wbs + i + 1] = true;
+            im[(wbs + 1 + i) * tw + wbs] = true;
+        }
+        let bs = (tw - fam.width_at_border) / 2;
+        for (i, (&bx, &by)) in fam.bit_x.iter().zip(fam.bit_y).enumerate().take(fam.nbits) {
+            if code & (1u64 << (fam.nbits - i - 1)) != 0 {
+                let x = bx as isize + bs as isize;
+                let y = by as isize + bs as isize;
+                if (0..tw as isize).contains(&x) && (0..tw as isize).contains(&y) {
+                    im[y as usize * tw + x as usize] = true;
+                }
+            }
+        }
+        Some((im, tw, fam.width_at_border))
+    }
+}
+
+/// A grayscale reflectance image, row-major, `width × height`.
+#[derive(Debug, Clone)]
+pub struct Canvas {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Reflectance per pixel.
+    pub data: Vec<f32>,
+    pixel_to_table: Homography,
+    table_to_pixel: Homography,
+}
+
+impl Canvas {
+    /// A canvas of uniform reflectance `fill` seen through `table_to_pixel`.
+    pub fn new(
+        width: usize,
+        height: usize,
+        table_to_pixel: Homography,
+        fill: f64,
+    ) -> Option<Canvas> {
+        Some(Canvas {
+            width,
+            height,
+            data: vec![fill as f32; width * height],
+            pixel_to_table: table_to_pixel.inverse()?,
+            table_to_pixel,
+        })
+    }
+
+    /// Pixel bounding box (x0, y0, x1, y1 exclusive) of table points, clipped to the image.
+    fn bbox(&self, pts: &[[f64; 2]]) -> Option<(usize, usize, usize, usize)> {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for p in pts {
+            let q = self.table_to_pixel.apply(*p)?;
+            for k in 0..2 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        let x0 = lo[0].floor().max(0.0) as usize;
+        let y0 = lo[1].floor().max(0.0) as usize;
+        let x1 = (hi[0].ceil() + 1.0).clamp(0.0, self.width as f64) as usize;
+        let y1 = (hi[1].ceil() + 1.0).clamp(0.0, self.height as f64) as usize;
+        (x0 < x1 && y0 < y1).then_some((x0, y0, x1, y1))
+    }
+
+    /// Cover the pixels in the box with `shade(p)` where it returns a value, averaging `n × n`
+    /// samples per pixel; samples where `shade` returns `None` keep the pixel's current value.
+    fn paint(
+        &mut self,
+        bbox: (usize, usize, usize, usize),
+        n: usize,
+        shade: impl Fn([f64; 2]) -> Option<f32>,
+    ) {
+        let (x0, y0, x1, y1) = bbox;
+        let inv = 1.0 / n as f64;
+        let h = self.pixel_to_table.0;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let old = self.data[y * self.width + x];
+                let mut sum = 0.0f32;
+                let mut hit = false;
+                for j in 0..n {
+                    let v = y as f64 + (j as f64 + 0.5) * inv;
+                    for i in 0..n {
+                        let u = x as f64 + (i as f64 + 0.5) * inv;
+                        let w = h[2][0] * u + h[2][1] * v + h[2][2];
+                        let p = [
+                            (h[0][0] * u + h[0][1] * v + h[0][2]) / w,
+                            (h[1][0] * u + h[1][1] * v + h[1][2]) / w,
+                        ];
+                        match shade(p) {
+                            Some(s) => {
+                                sum += s;
+                                hit = true;
+                            }
+                            None => sum += old,
+                        }
+                    }
+                }
+                if hit {
+                    self.data[y * self.width + x] = sum / (n * n) as f32;
+                }
+            }
+        }
+    }
+
+    /// Draw a filled polygon (even-odd rule). A homography maps lines to lines, so the polygon
+    /// is mapped to pixels and covered scanline by scanline: `n` sub-rows per pixel row, each
+    /// with exact horizontal coverage.
+    pub fn polygon(&mut self, poly: &Polygon, n: usize) {
+        if poly.points.len() < 3 {
+            return;
+        }
+        let Some(px) = poly
+            .points
+            .iter()
+            .map(|p| self.table_to_pixel.apply(*p))
+            .collect::<Option<Vec<_>>>()
+        else {
+            return;
+        };
+        let Some((x0, y0, x1, y1)) = self.bbox(&poly.points) else {
+            return;
+        };
+        let n = n.max(1);
+        let shade = poly.shade as f32;
+        let mut cov = vec![0.0f64; x1 - x0];
+        let mut xs: Vec<f64> = Vec::new();
+        for y in y0..y1 {
+            cov.iter_mut().for_each(|c| *c = 0.0);
+            for j in 0..n {
+                let yy = y as f64 + (j as f64 + 0.5) / n as f64;
+                xs.clear();
+                for (i, &a) in px.iter().enumerate() {
+                    let b = px[(i + 1) % px.len()];
+                    if (a[1] > yy) != (b[1] > yy) {
+                        xs.push(a[0] + (yy - a[1]) * (b[0] - a[0]) / (b[1] - a[1]));
+                    }
+                }
+                xs.sort_by(|a, b| a.total_cmp(b));
+                for span in xs.chunks_exact(2) {
+                    let (xa, xb) = (span[0].max(x0 as f64), span[1].min(x1 as f64));
+                    if xb <= xa {
+                        continue;
+                    }
+                    let (ia, ib) = (xa.floor() as usize, xb.floor() as usize);
+                    if ia == ib {
+                        cov[ia - x0] += xb - xa;
+                        continue;
+                    }
+                    cov[ia - x0] += (ia + 1) as f64 - xa;
+                    for c in &mut cov[ia + 1 - x0..ib.min(x1) - x0] {
+                        *c += 1.0;
+                    }
+                    if ib < x1 {
+                        cov[ib - x0] += xb - ib as f64;
+                    }
+                }
+            }
+            let row = &mut self.data[y * self.width + x0..y * self.width + x1];
+            for (v, c) in row.iter_mut().zip(&cov) {
+                let c = (*c / n as f64) as f32;
+                *v = *v * (1.0 - c) + shade * c;
+            }
+        }
+    }
+
+    /// Draw a marker with a white quiet zone `quiet_cells` wide around the tag image (beyond the
+    /// family's own one-cell white border), `n × n` supersampling; `black`/`white` reflectances.
+    #[allow(clippy::too_many_arguments)]
+    pub fn marker(
+        &mut self,
+        codes: &TagCodes,
+        m: &MarkerPlacement,
+        quiet_cells: f64,
+        n: usize,
+        black: f64,
+        white: f64,
+    ) -> Result<(), String> {
+        let (pattern, tw, wab) = codes
+            .pattern(m.family, m.id)
+            .ok_or_else(|| format!("{} has no id {}", m.family.name(), m.id))?;
+        if !(m.side > 0.0 && m.side.is_finite()) {
+            return Err(format!("marker {} has side {}", m.id, m.side));
+        }
+        let cell = m.side / wab as f64;
+        let half = (tw as f64 / 2.0 + quiet_cells) * cell;
+        let outer = MarkerPlacement {
+            side: 2.0 * half,
+            ..*m
+        };
+        let Some(bbox) = self.bbox(&outer.corners()) else {
+            return Ok(());
+        };
+        let (s, c) = m.heading.sin_cos();
+        let (b, w) = (black as f32, white as f32);
+        let twf = tw as f64;
+        self.paint(bbox, n, |p| {
+            let d = [p[0] - m.centre[0], p[1] - m.centre[1]];
+            let a = c * d[0] + s * d[1];
+            let bb = -s * d[0] + c * d[1];
+            if a.abs() >= half || bb.abs() >= half {
+                return None;
+            }
+            let col = a / cell + twf / 2.0;
+            let row = twf / 2.0 - bb / cell;
+            if col < 0.0 || row < 0.0 || col >= twf || row >= twf {
+                return Some(w);
+            }
+            Some(if pattern[row as usize * tw + col as usize] {
+                w
+            } else {
+                b
+            })
+        });
+        Ok(())
+    }
+}
+
+/// Even-odd point-in-polygon test.
+pub fn point_in_polygon(pts: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    let mut j = pts.len() - 1;
+    for i in 0..pts.len() {
+        let (a, b) = (pts[i], pts[j]);
+        if (a[1] > p[1]) != (b[1] > p[1])
+            && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0]
+        {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
+/// Separable Gaussian blur with standard deviation `sigma` pixels (edges clamped).
+pub fn gaussian_blur(data: &mut [f32], width: usize, height: usize, sigma: f64) {
+    if sigma <= 0.0 || width == 0 || height == 0 {
+        return;
+    }
+    let r = (3.0 * sigma).ceil() as isize;
+    let mut k: Vec<f32> = (-r..=r)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
+        .collect();
+    let sum: f32 = k.iter().sum();
+    k.iter_mut().for_each(|v| *v /= sum);
+    let mut tmp = vec![0.0f32; data.len()];
+    let (w, h) = (width as isize, height as isize);
+    for y in 0..h {
+        let row = &data[(y * w) as usize..((y + 1) * w) as usize];
+        for x in 0..w {
+            let mut acc = 0.0;
+            for (t, kv) in k.iter().enumerate() {
+                let xx = (x + t as isize - r).clamp(0, w - 1);
+                acc += kv * row[xx as usize];
+            }
+            tmp[(y * w + x) as usize] = acc;
+        }
+    }
+    for y in 0..h {
+        for x in 0..w {
+            let mut acc = 0.0;
+            for (t, kv) in k.iter().enumerate() {
+                let yy = (y + t as isize - r).clamp(0, h - 1);
+                acc += kv * tmp[(yy * w + x) as usize];
+            }
+            data[(y * w + x) as usize] = acc;
+        }
+    }
+}
+
+/// The sensor: gray level = `black + (white − black) · exposure · reflectance + noise`, rounded
+/// and clamped to 8 bits; `noise_sigma` in gray levels.
+pub fn develop(
+    data: &[f32],
+    exposure: f64,
+    black: f64,
+    white: f64,
+    noise_sigma: f64,
+    rng: &mut impl Rng,
+) -> Vec<u8> {
+    let noise = Normal::new(0.0f32, noise_sigma.max(0.0) as f32).ok();
+    let gain = ((white - black) * exposure) as f32;
+    let black = black as f32;
+    data.iter()
+        .map(|&r| {
+            let n = match &noise {
+                Some(d) if noise_sigma > 0.0 => d.sample(rng),
+                _ => 0.0,
+            };
+            (black + gain * r + n).round().clamp(0.0, 255.0) as u8
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn homography_inverse_round_trips() {
+        let h = Homography([
+            [700.0, 3.0, 20.0],
+            [-2.0, -690.0, 700.0],
+            [1e-4, -2e-4, 1.0],
+        ]);
+        let inv = h.inverse().unwrap();
+        for p in [[0.1, 0.2], [1.1, 0.85], [0.6, 0.0]] {
+            let q = inv.apply(h.apply(p).unwrap()).unwrap();
+            assert!((q[0] - p[0]).abs() < 1e-12 && (q[1] - p[1]).abs() < 1e-12);
+        }
+    }
+
+    /// The rendered tag36h11 id 0 matches the published tag image (first rows of
+    /// tag36_11_00000.png: white border, black ring, then the code bits).
+    #[test]
+    fn tag36h11_pattern_has_border_and_ring() {
+        let codes = TagCodes::new().unwrap();
+        let (p, tw, wab) = codes.pattern(MarkerFamily::Tag36h11, 0).unwrap();
+        assert_eq!((tw, wab), (10, 8));
+        for i in 0..tw {
+            assert!(
+                p[i] && p[(tw - 1) * tw + i] && p[i * tw] && p[i * tw + tw - 1],
+                "white border"
+            );
+        }
+        for i in 1..tw - 1 {
+            assert!(
+                !p[tw + i] && !p[(tw - 2) * tw + i] && !p[i * tw + 1] && !p[i * tw + tw - 2],
+                "black ring"
+            );
+        }
+        // Bits read back in the family's order give the code.
+        let fam = &TAG36H11;
+        let mut code = 0u64;
+        for (&bx, &by) in fam.bit_x.iter().zip(fam.bit_y) {
+            let (x, y) = (bx as usize + 1, by as usize + 1);
+            code = (code << 1) | p[y * tw + x] as u64;
+        }
+        assert_eq!(code, fam.codes[0]);
+        assert_eq!(code, 0x0000000d7e00984b, "tag36h11 id 0 as published");
+        assert!(codes.pattern(MarkerFamily::Tag36h11, 587).is_none());
+    }
+
+    /// A half-plane edge at a sub-pixel position is rendered with the exact area coverage.
+    #[test]
+    fn edge_coverage_is_subpixel_exact() {
+        let mut c = Canvas::new(8, 4, Homography::IDENTITY, 0.0).unwrap();
+        let poly = Polygon {
+            points: vec![[0.0, 0.0], [3.25, 0.0], [3.25, 4.0], [0.0, 4.0]],
+            shade: 1.0,
+        };
+        c.polygon(&poly, 8);
+        assert_eq!(c.data[2], 1.0);
+        assert!((c.data[3] - 0.25).abs() < 1e-6, "{}", c.data[3]);
+        assert_eq!(c.data[4], 0.0);
+    }
+
+    #[test]
+    fn blur_keeps_mean() {
+        let mut d = vec![0.0f32; 100];
+        d[55] = 1.0;
+        gaussian_blur(&mut d, 10, 10, 0.8);
+        let s: f32 = d.iter().sum();
+        assert!((s - 1.0).abs() < 1e-4);
+        assert!(d[55] < 0.5 && d[54] > 0.0);
+    }
+}
