@@ -479,23 +479,17 @@ impl Core {
                 }
                 return;
             }
-            Kind::Move {
-                cruise,
-                stop_on_contact,
-            } => {
-                if stop_on_contact && self.bumper.state() != 0 {
-                    self.finish(now_us, Outcome::Contact);
-                    self.motors_off();
-                    return;
-                }
-                self.v_ref = self
-                    .profile
-                    .step(dt, cruise.min(lim.max_speed), lim.max_accel);
-                self.w_ref = ramp(self.w_ref, 0.0, lim.max_alpha * dt);
-                self.params.distance_tolerance
-            }
-            Kind::Advance { cruise } => {
-                if self.bumper.state() != 0 {
+            Kind::Move { cruise, .. } | Kind::Advance { cruise } => {
+                // Advancing is a straight move that always stops at contact.
+                let stops_on_contact = matches!(
+                    a.kind,
+                    Kind::Advance { .. }
+                        | Kind::Move {
+                            stop_on_contact: true,
+                            ..
+                        }
+                );
+                if stops_on_contact && self.bumper.state() != 0 {
                     self.finish(now_us, Outcome::Contact);
                     self.motors_off();
                     return;
