@@ -104,6 +104,9 @@ pub trait RobotIo {
     fn robot_pose(&mut self) -> Pose2;
     /// The object's marker pose in the table frame, as the camera sees it.
     fn object_pose(&mut self) -> Pose2;
+    /// The pose of the object named `id` in the scene (its body frame, not its marker), in the
+    /// table frame, as the camera sees it; `None` when there is no such object or it is not seen.
+    fn body_pose(&mut self, id: &str) -> Option<Pose2>;
     /// Time since the start, s (simulated time in simulation).
     fn time(&self) -> f64;
     /// The workspace.
@@ -483,6 +486,12 @@ impl RobotIo for SimRobot {
     fn object_pose(&mut self) -> Pose2 {
         let p = self.true_object_pose();
         self.noisy(p)
+    }
+
+    fn body_pose(&mut self, id: &str) -> Option<Pose2> {
+        let (_, p) = self.sim.object_poses().into_iter().find(|(o, _)| o == id)?;
+        let p = Pose2::new(p.x - self.margin, p.y - self.margin, p.theta);
+        Some(self.noisy(p))
     }
 
     fn time(&self) -> f64 {
