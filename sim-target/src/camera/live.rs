@@ -63,8 +63,8 @@ impl LiveCamera {
         opts: &LiveCameraOptions,
         view: WorldView,
     ) -> Result<LiveCamera> {
-        let mut camera =
-            SceneCamera::new(scene, seed ^ 0x00CA_3E4A).context("setting up the simulated camera")?;
+        let mut camera = SceneCamera::new(scene, seed ^ 0x00CA_3E4A)
+            .context("setting up the simulated camera")?;
         let server = CameraServer::bind(opts.addr.as_str())
             .with_context(|| format!("binding the camera socket {}", opts.addr))?;
         let addr = server.local_addr();
