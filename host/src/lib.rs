@@ -8,5 +8,6 @@ pub mod cli;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
+pub mod plot;
 pub mod strategy;
 pub mod vision;
