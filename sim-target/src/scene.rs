@@ -47,6 +47,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::robot::Pose;
 
+pub mod rearrange;
+
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -71,6 +73,9 @@ pub struct Scene {
     /// Named poses (start positions of a layout, waypoints).
     #[serde(default)]
     pub positions: Vec<NamedPose>,
+    /// Grid rearrangement planning settings (see [`rearrange`]); the simulator ignores them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rearrange: Option<rearrange::Rearrange>,
 }
 
 /// The table: a rectangle with its origin at the lower-left corner; its edges are walls.
