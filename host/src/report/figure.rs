@@ -42,7 +42,7 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
     );
     let _ = writeln!(
         s,
-        r#"<rect x="0" y="0" width="{w:.1}" height="{h:.1}" fill="#f6f6f2" stroke="black" stroke-width="2"/>"#
+        r##"<rect x="0" y="0" width="{w:.1}" height="{h:.1}" fill="#f6f6f2" stroke="black" stroke-width="2"/>"##
     );
     let _ = writeln!(
         s,
@@ -95,7 +95,7 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
         if let Some(pts) = outline_at(scene, &o.id, first) {
             let _ = writeln!(
                 s,
-                r#"<polygon points="{}" fill="none" stroke="#888" stroke-dasharray="4,3"/>"#,
+                r##"<polygon points="{}" fill="none" stroke="#888" stroke-dasharray="4,3"/>"##,
                 points(&pts, h)
             );
         }
