@@ -112,9 +112,9 @@ fn learned_delivery_succeeds_from_two_starts_and_dipole_runs_beside_it() {
 #[test]
 fn reset_robot_obj_boundary_brings_the_object_back() {
     let mut scene = Scene::preset("lau-irregular").unwrap();
-    // Object 8 cm past the lower boundary (inset 0.2 m), robot above it.
-    scene.objects[0].pose = Pose::new(0.8, 0.12, 0.3);
-    scene.robot.start = Pose::new(0.8, 0.3, -1.5);
+    // Object 3.5 cm past the lower boundary (inset 0.1 m), robot above it.
+    scene.objects[0].pose = Pose::new(0.8, 0.065, 0.3);
+    scene.robot.start = Pose::new(0.8, 0.25, -1.5);
     let mut io = SimRobot::new(scene, None, None, SimRobotOptions::default()).unwrap();
     let ws = io.workspace();
     assert!(!ws.boundary.contains(io.object_pose().position()));
