@@ -57,7 +57,9 @@ pub fn text(name: &str) -> Option<String> {
         ),
         "lau-snake" => lau(name, SNAKE, [0.0, 0.0], 0.1, SUPPORT_UNIFORM),
         // The irregular object at A behind a wall from the top edge down to y = 0.45 m.
-        "lau-obstacles" => lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &obstacle(7.8, 4.5, 8.8, 12.0),
+        "lau-obstacles" => {
+            lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &obstacle(7.8, 4.5, 8.8, 12.0)
+        }
         "bsr-a" => bsr_a(),
         "bsr-b" => bsr_b(),
         "bsr-c" => bsr_c(),
