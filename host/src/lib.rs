@@ -5,8 +5,10 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod exec;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
+pub mod report;
 pub mod strategy;
 pub mod vision;
