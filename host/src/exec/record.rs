@@ -165,7 +165,11 @@ mod tests {
         let trace = rec.trace();
         assert_eq!(trace.len(), 4);
         assert_eq!(trace[1].after, "forward");
-        assert!((rec.robot_path_length() - 0.15).abs() < 0.02, "{}", rec.robot_path_length());
+        assert!(
+            (rec.robot_path_length() - 0.15).abs() < 0.02,
+            "{}",
+            rec.robot_path_length()
+        );
         assert!((rec.distance_commanded() - 0.15).abs() < 1e-12);
         assert!(trace.windows(2).all(|w| w[1].t > w[0].t));
         assert_eq!(trace[3].objects.len(), 1);

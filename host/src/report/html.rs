@@ -74,12 +74,7 @@ figcaption {{ font-size: .9em; color: #555; max-width: 520px; }}
                     serde_json::Value::String(t) => t.clone(),
                     other => other.to_string(),
                 };
-                let _ = writeln!(
-                    h,
-                    "<tr><th>{}</th><td>{}</td></tr>",
-                    escape(k),
-                    escape(&v)
-                );
+                let _ = writeln!(h, "<tr><th>{}</th><td>{}</td></tr>", escape(k), escape(&v));
             }
             h.push_str("</table>\n");
         }
