@@ -67,6 +67,10 @@ pub struct DemoArgs {
     /// Where collected pushing strategies are cached (default: OUT/cache).
     #[arg(long)]
     pub cache: Option<PathBuf>,
+    /// Keep a live view while it runs: open OUT/live/live.html in a browser (the camera image
+    /// with detected markers, tracked poses and the current path, refreshed after every look).
+    #[arg(long)]
+    pub view: bool,
 }
 
 /// Everything a stage needs.
@@ -114,6 +118,7 @@ impl Ctx<'_> {
         let opts = LiveOptions {
             object: object.map(str::to_owned),
             watchdog_ms: (1000.0 * speed.max(1.0)).min(5000.0) as u16,
+            view_dir: self.args.view.then(|| self.args.out.join("live")),
             ..LiveOptions::default()
         };
         match (&self.args.port, &self.args.camera) {
@@ -211,6 +216,12 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
         log,
     };
     let t0 = Instant::now();
+    if args.view && !g.json {
+        println!(
+            "live view: open {} in a browser",
+            args.out.join("live").join("live.html").display()
+        );
+    }
     for stage in &args.stages {
         let started = Instant::now();
         let result = match stage.as_str() {

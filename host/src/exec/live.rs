@@ -55,6 +55,9 @@ pub struct LiveOptions {
     /// real time, multiply it by N (the host's threads get N times less wall time per robot
     /// second).
     pub watchdog_ms: u16,
+    /// Keep a live view (camera image, detections, tracked poses) in this folder
+    /// ([`super::view`]).
+    pub view_dir: Option<std::path::PathBuf>,
     /// The serial link's settings.
     pub link: LinkOptions,
 }
@@ -68,10 +71,11 @@ impl Default for LiveOptions {
             object: None,
             detector: DetectorKind::ApriltagC,
             calibration: None,
-            frames_per_look: 2,
+            frames_per_look: 1,
             frame_timeout: Duration::from_secs(10),
             fps: 30.0,
             watchdog_ms: 1000,
+            view_dir: None,
             link: LinkOptions::default(),
         }
     }
@@ -95,6 +99,7 @@ pub struct LiveRobot {
     camera_error: Option<String>,
     t0_us: u64,
     frames_seen: u64,
+    view: Option<super::view::LiveView>,
 }
 
 impl std::fmt::Debug for LiveRobot {
@@ -167,6 +172,10 @@ impl LiveRobot {
             ..TrackerParams::default()
         };
         let pipeline = Pipeline::new(detector, layout, calibration, params);
+        let view = match &opts.view_dir {
+            Some(d) => Some(super::view::LiveView::create(d)?),
+            None => None,
+        };
         let mut live = LiveRobot {
             robot,
             grabber,
@@ -179,6 +188,7 @@ impl LiveRobot {
             camera_error: None,
             t0_us,
             frames_seen: 0,
+            view,
             opts,
         };
         live.look()?;
@@ -199,6 +209,11 @@ impl LiveRobot {
     /// The calibration in use.
     pub fn calibration(&self) -> &Calibration {
         self.pipeline.calibration()
+    }
+
+    /// The live view, if one is kept: set its `plan` to draw a path.
+    pub fn view_mut(&mut self) -> Option<&mut super::view::LiveView> {
+        self.view.as_mut()
     }
 
     /// Frames processed so far.
@@ -222,6 +237,11 @@ impl LiveRobot {
             after = n;
             let r = self.pipeline.process(&frame)?;
             self.frames_seen += 1;
+            if let Some(v) = self.view.as_mut()
+                && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
+            {
+                tracing::warn!("live view: {e:#}");
+            }
             for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
                 let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
                 self.poses.insert(t.body.clone(), (p, t.time));

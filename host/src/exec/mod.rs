@@ -10,6 +10,7 @@ pub mod grabber;
 pub mod live;
 pub mod record;
 pub mod target;
+pub mod view;
 
 pub use live::{LiveOptions, LiveRobot};
 pub use target::SimTarget;
