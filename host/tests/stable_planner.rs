@@ -6,7 +6,7 @@ use pushbot::mechanics::stable::stable;
 use pushbot::mechanics::{V2, V3, cor};
 use pushbot::planner::stable::presets::{CostOverride, PRESETS, load_scene, parse_scene};
 use pushbot::planner::stable::pusher::PusherKind;
-use pushbot::planner::stable::search::{Plan, brute_force_cost, exact_goal};
+use pushbot::planner::stable::search::{Heuristic, Plan, brute_force_cost, exact_goal};
 use pushbot::planner::stable::{Pose, Problem, Queue, angle_diff, plan, plan_with};
 
 /// Separating-axis overlap test of two convex polygons (closed: touching overlaps).
@@ -470,4 +470,74 @@ kind = "arm"
         .to_string();
     assert!(e.contains("task.start"), "{e}");
     let _ = Pose::new(0.0, 0.0, 0.0);
+}
+
+/// The A* bound never exceeds the number of steps a found plan still takes (admissibility),
+/// from every configuration along the plan, on every preset.
+#[test]
+fn heuristic_is_a_lower_bound_along_found_plans() {
+    for name in PRESETS {
+        let p = load_scene(name)
+            .unwrap()
+            .problem(CostOverride::default())
+            .unwrap();
+        let pl = plan(&p);
+        assert!(pl.found, "{name}");
+        let h = Heuristic::new(&p);
+        let n = pl.steps.len();
+        for (i, s) in pl.steps.iter().enumerate() {
+            let b = h.steps(&s.from);
+            assert!(
+                b as usize <= n - i,
+                "{name}: step {i}: bound {b} > {}",
+                n - i
+            );
+        }
+        // And it is not trivial: from the start it needs a good part of the plan's steps.
+        let b0 = h.steps(&p.start) as usize;
+        assert!(b0 >= 3 && b0 <= n, "{name}: bound {b0} of {n} steps");
+    }
+}
+
+/// The precomputed swept-shape test gives the same answer as conservative advancement, for
+/// steps of every control from configurations scattered over the table (many near obstacles).
+#[test]
+fn swept_shape_test_agrees_with_conservative_advancement() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    for name in ["fig13", "fig16", "fig18"] {
+        let p = load_scene(name)
+            .unwrap()
+            .problem(CostOverride::default())
+            .unwrap();
+        let (w, h) = p.world.table;
+        let (mut free, mut blocked) = (0, 0);
+        for _ in 0..1500 {
+            let q = Pose::new(
+                rng.random_range(0.0..w),
+                rng.random_range(0.0..h),
+                rng.random_range(-3.2..3.2),
+            );
+            for cm in &p.contacts {
+                if !cm.body.free_at(&p.world, &q) {
+                    continue;
+                }
+                for (k, xi) in cm.steps.iter().enumerate() {
+                    let a = cm.body.step_free(&p.world, &q, xi);
+                    let b = cm.body.step_free_swept(&p.world, &q, xi, &cm.swept[k]);
+                    assert_eq!(a, b, "{name}: q {q:?} control {k}");
+                    if a { free += 1 } else { blocked += 1 }
+                }
+                for (k, xi) in cm.fine_steps.iter().enumerate() {
+                    let a = cm.body.step_free(&p.world, &q, xi);
+                    let b = cm.body.step_free_swept(&p.world, &q, xi, &cm.fine_swept[k]);
+                    assert_eq!(a, b, "{name}: q {q:?} fine control {k}");
+                }
+            }
+        }
+        assert!(
+            free > 100 && blocked > 50,
+            "{name}: {free} free, {blocked} blocked"
+        );
+    }
 }
