@@ -553,24 +553,38 @@ impl World {
         self.move_objects(&sol.moves);
         let k = sol.scale;
         let (ax, ay, dth2) = (k * dx, k * dy, k * dth);
-        // Second-order corrections: the linearised step may leave an object a hair inside
-        // something (it turned); push it back out with the robot held where it ends.
-        let after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
-        for _ in 0..3 {
-            let fix = self.rows(&after, 0.0, true);
+        // Second-order corrections: the linearised step may leave a body a hair inside
+        // something (an object turned). Push it back out; here the robot is a very stiff
+        // mobile body too, so that an object wedged between it and a wall can push it back.
+        let (mut ax, mut ay, mut dth2) = (ax, ay, dth2);
+        let mut after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
+        for _ in 0..4 {
+            let mut fix = self.rows(&after, 0.0, true);
             if fix.iter().all(|r| r.gap >= -1e-12) {
                 break;
             }
-            let m = self.mobiles();
-            let still = Drive {
-                centre: [after.x, after.y],
-                ..Drive::default()
-            };
-            let s = crate::quasistatic::solve(&m, &fix, &still);
-            if s.residual > crate::quasistatic::FEASIBLE {
-                break;
+            let mut m = self.mobiles();
+            let robot = m.len();
+            let stiff = m.iter().map(|b| b.s).fold(f64::INFINITY, f64::min) * 1e-2;
+            m.push(Mobile {
+                cof: [after.x, after.y],
+                c: self.shape.radius(),
+                s: if stiff.is_finite() { stiff } else { 1e-3 },
+            });
+            for r in &mut fix {
+                for b in [&mut r.a, &mut r.b] {
+                    if *b == BodyRef::Robot {
+                        *b = BodyRef::Object(robot);
+                    }
+                }
             }
-            self.move_objects(&s.moves);
+            let s = crate::quasistatic::solve(&m, &fix, &Drive::default());
+            self.move_objects(&s.moves[..robot]);
+            let [rx, ry, rth] = s.moves[robot];
+            ax += rx;
+            ay += ry;
+            dth2 += rth;
+            after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
         }
         self.pressed = self.presses(&rows, &sol, &drive, &after);
         (ax, ay, dth2, k < 1.0 - 1e-12)
@@ -749,11 +763,13 @@ impl World {
     }
 }
 
-/// Whether two simple polygons (table frame) overlap by more than a touch (parry2d contacts
-/// between their convex parts). Unusable polygons count as overlapping nothing.
+/// Whether two simple polygons (table frame) overlap by more than a touch (more than 1 µm,
+/// the solver's contact skin [`crate::quasistatic::SKIN`]; parry2d contacts between their
+/// convex parts). Unusable polygons count as overlapping
+/// nothing.
 pub fn polygons_overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> bool {
     match (Outline::polygon(a), Outline::polygon(b)) {
-        (Ok(a), Ok(b)) => a.overlaps(&Pose::default(), &b, &Pose::default(), 1e-12),
+        (Ok(a), Ok(b)) => a.overlaps(&Pose::default(), &b, &Pose::default(), 1e-6),
         _ => false,
     }
 }
