@@ -131,6 +131,37 @@ pub fn check_simple(outline: &[[f64; 2]]) -> Result<(), ShapeError> {
     Ok(())
 }
 
+/// Corner radius of polygon parts, m: each convex part is its polygon inset by this much with
+/// its border rounded by as much (the same outline, corners rounded by 10 µm). With a border,
+/// parry finds shallow overlaps (up to twice this) from the inner polygons' closest points,
+/// which is robust, rather than from the penetration algorithm (EPA), which can miss contacts
+/// that touch to within its tolerance.
+pub const BORDER: f64 = 1e-5;
+
+/// A convex polygon as an inset polygon with a rounded border of [`BORDER`] (the polygon as is
+/// if it is too thin to inset).
+fn rounded(c: ConvexPolygon) -> SharedShape {
+    let (pts, normals) = (c.points(), c.normals());
+    let n = pts.len();
+    // parry's `ConvexPolygon::offsetted`, inwards: each vertex moves along the bisector.
+    let inset: Vec<Vector> = (0..n)
+        .map(|i2| {
+            let i1 = (i2 + n - 1) % n;
+            let dir = normals[i1] + normals[i2];
+            pts[i2] - (BORDER / dir.dot(normals[i1])) * dir
+        })
+        .collect();
+    // Usable if every inset edge keeps its direction (nothing flipped).
+    let kept = (0..n).all(|i| {
+        let (a, b) = (pts[(i + 1) % n] - pts[i], inset[(i + 1) % n] - inset[i]);
+        a.dot(b) > 0.0 && b.length() > 0.0
+    });
+    if kept && let Some(s) = SharedShape::round_convex_polyline(inset, BORDER) {
+        return s;
+    }
+    SharedShape::new(c)
+}
+
 fn is_convex_ccw(pts: &[Vector]) -> bool {
     let n = pts.len();
     (0..n).all(|i| {
@@ -158,7 +189,7 @@ impl Outline {
             .into_iter()
             .map(|p| {
                 ConvexPolygon::from_convex_polyline(p)
-                    .map(|c| (PPose::IDENTITY, SharedShape::new(c)))
+                    .map(|c| (PPose::IDENTITY, rounded(c)))
                     .ok_or(ShapeError::Decomposition)
             })
             .collect::<Result<Vec<_>, _>>()?;

@@ -763,13 +763,12 @@ impl World {
     }
 }
 
-/// Whether two simple polygons (table frame) overlap by more than a touch (more than 1 µm,
-/// the solver's contact skin [`crate::quasistatic::SKIN`]; parry2d contacts between their
-/// convex parts). Unusable polygons count as overlapping
+/// Whether two simple polygons (table frame) overlap by more than a touch (more than 1 nm;
+/// parry2d contacts between their convex parts). Unusable polygons count as overlapping
 /// nothing.
 pub fn polygons_overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> bool {
     match (Outline::polygon(a), Outline::polygon(b)) {
-        (Ok(a), Ok(b)) => a.overlaps(&Pose::default(), &b, &Pose::default(), 1e-6),
+        (Ok(a), Ok(b)) => a.overlaps(&Pose::default(), &b, &Pose::default(), 1e-9),
         _ => false,
     }
 }
