@@ -132,11 +132,11 @@ pub fn check_simple(outline: &[[f64; 2]]) -> Result<(), ShapeError> {
 }
 
 /// Corner radius of polygon parts, m: each convex part is its polygon inset by this much with
-/// its border rounded by as much (the same outline, corners rounded by 10 µm). With a border,
+/// its border rounded by as much (the same outline, corners rounded by 1 µm). With a border,
 /// parry finds shallow overlaps (up to twice this) from the inner polygons' closest points,
 /// which is robust, rather than from the penetration algorithm (EPA), which can miss contacts
 /// that touch to within its tolerance.
-pub const BORDER: f64 = 1e-5;
+pub const BORDER: f64 = 1e-6;
 
 /// A convex polygon as an inset polygon with a rounded border of [`BORDER`] (the polygon as is
 /// if it is too thin to inset).

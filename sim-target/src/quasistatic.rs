@@ -99,7 +99,7 @@ const TOL: f64 = 1e-13;
 /// A step is feasible when every linearised gap is closed to within this, m.
 pub const FEASIBLE: f64 = 1e-12;
 /// The solve keeps contacts this far apart (m), so that rounding never makes them overlap.
-pub const SKIN: f64 = 1e-6;
+pub const SKIN: f64 = 1e-9;
 
 /// The gap a contact must keep: [`SKIN`], or what it has if less (a contact that started
 /// closer is not pushed apart, one that started overlapping is pushed out to touching).
