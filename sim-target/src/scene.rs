@@ -101,6 +101,8 @@ pub struct RobotSpec {
     pub stall_torque: f64,
     /// True start pose.
     pub start: Pose,
+    /// A flat front bumper plate (`{ width, offset }`, m); none: the round bumper only.
+    pub front_plate: Option<crate::world::FrontPlate>,
 }
 
 impl Default for RobotSpec {
@@ -115,6 +117,7 @@ impl Default for RobotSpec {
             no_load_speed: m.no_load_speed(),
             stall_torque: m.stall_torque(),
             start: Pose::new(0.2, 0.2, 0.0),
+            front_plate: None,
         }
     }
 }
