@@ -2,16 +2,16 @@
 //! obstacles and the table walls, checked along each push step, not only at its end.
 //!
 //! The paper grows a bounding disk of `PS` by the step length and checks only the step's end.
-//! Here `PS` is its real polygons (parry2d convex polygons) and a step — a constant twist in the
+//! Here `PS` is its real polygons (parry2d-f64 convex polygons) and a step — a constant twist in the
 //! slider frame, i.e. a rotation about a fixed centre or a translation — is checked by
 //! *conservative advancement*: at time `t` the distance `d` from `PS(t)` to the obstacles is
 //! measured, and no point of `PS` moves farther than `D·Δt` in `Δt` (`D` = largest arc length
 //! of any vertex over the step), so `PS` cannot touch anything before `t + d/D`. Touching counts
 //! as collision (obstacles are closed).
 
-use parry2d::math::{Pose as PPose, Vector as PVec};
-use parry2d::query;
-use parry2d::shape::ConvexPolygon;
+use parry2d_f64::math::{Pose as PPose, Vector as PVec};
+use parry2d_f64::query;
+use parry2d_f64::shape::ConvexPolygon;
 
 use super::Pose;
 use crate::mechanics::{V2, V3, convex_hull};
@@ -39,10 +39,7 @@ impl std::fmt::Debug for Obstacle {
 
 /// Convert a point list to a parry convex polygon (the convex hull of the points).
 pub fn convex(points: &[V2]) -> Option<ConvexPolygon> {
-    let pts: Vec<PVec> = points
-        .iter()
-        .map(|p| PVec::new(p.x as f32, p.y as f32))
-        .collect();
+    let pts: Vec<PVec> = points.iter().map(|p| PVec::new(p.x, p.y)).collect();
     ConvexPolygon::from_convex_hull(&pts)
 }
 
@@ -178,7 +175,7 @@ impl Body {
     /// Smallest distance from the body at `q` to any obstacle whose box is within `reach` of
     /// `q`'s origin (`f64::INFINITY` if none).
     pub fn clearance(&self, world: &World, q: &Pose, reach: f64) -> f64 {
-        let pose = PPose::new(PVec::new(q.x as f32, q.y as f32), q.theta as f32);
+        let pose = PPose::new(PVec::new(q.x, q.y), q.theta);
         let r = self.radius + reach;
         let mut best = f64::INFINITY;
         for o in &world.obstacles {
@@ -192,7 +189,7 @@ impl Body {
             }
             for part in &self.parts {
                 let d = query::distance(&pose, part, &PPose::identity(), &o.shape)
-                    .map(|d| d.distance as f64)
+                    .map(|d| d.distance)
                     .unwrap_or(0.0);
                 best = best.min(d);
                 if best <= CONTACT_EPS {
@@ -261,7 +258,7 @@ impl Body {
     /// decides. The answer is the same as [`Body::step_free`]'s.
     pub fn step_free_swept(&self, world: &World, q: &Pose, xi: &V3, sw: &Swept) -> bool {
         let c = q.apply(sw.centre);
-        let pose = PPose::new(PVec::new(q.x as f32, q.y as f32), q.theta as f32);
+        let pose = PPose::new(PVec::new(q.x, q.y), q.theta);
         let mut hit = false;
         'obstacles: for o in &world.obstacles {
             let b = o.bounds;

@@ -12,7 +12,7 @@
 //! goal exactly.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
@@ -94,10 +94,9 @@ pub struct Plan {
 /// Which OPEN list to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Queue {
-    /// The paper's array of lists indexed by integer cost (here `f = g + h`), each list ordered
-    /// by the step lower bound (ties broken towards the goal) and then first in, first out.
+    /// The paper's array of first-in first-out lists indexed by integer cost (here `f = g + h`).
     Buckets,
-    /// A binary heap ordered by `(f, step lower bound, insertion order)`; for cross-checking.
+    /// A binary heap ordered by `(f, insertion order)`; for cross-checking.
     Heap,
 }
 
@@ -351,26 +350,26 @@ pub fn step_cost(
     Some(c)
 }
 
-/// OPEN: the paper's cost-indexed buckets (each a small heap on the tie key) or one heap.
+/// OPEN: the paper's cost-indexed FIFO lists, or one heap.
 enum Open {
     Buckets {
-        lists: Vec<BinaryHeap<Reverse<(u32, u32)>>>,
+        lists: Vec<VecDeque<u32>>,
         cur: usize,
     },
-    Heap(BinaryHeap<Reverse<(u32, u32, u32)>>),
+    Heap(BinaryHeap<Reverse<(u32, u32)>>),
 }
 
 impl Open {
-    fn push(&mut self, f: u32, tie: u32, id: u32) {
+    fn push(&mut self, f: u32, id: u32) {
         match self {
             Open::Buckets { lists, cur } => {
                 let f = f as usize;
                 if f < lists.len() {
-                    lists[f].push(Reverse((tie, id)));
+                    lists[f].push_back(id);
                     *cur = (*cur).min(f);
                 }
             }
-            Open::Heap(h) => h.push(Reverse((f, tie, id))),
+            Open::Heap(h) => h.push(Reverse((f, id))),
         }
     }
 
@@ -378,14 +377,14 @@ impl Open {
         match self {
             Open::Buckets { lists, cur } => {
                 while *cur < lists.len() {
-                    if let Some(Reverse((_, id))) = lists[*cur].pop() {
+                    if let Some(id) = lists[*cur].pop_front() {
                         return Some(id);
                     }
                     *cur += 1;
                 }
                 None
             }
-            Open::Heap(h) => h.pop().map(|Reverse((_, _, id))| id),
+            Open::Heap(h) => h.pop().map(|Reverse((_, id))| id),
         }
     }
 }
@@ -414,13 +413,12 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     let max_cost = p.params.max_cost;
     let mut open = match queue {
         Queue::Buckets => Open::Buckets {
-            lists: (0..=max_cost as usize).map(|_| BinaryHeap::new()).collect(),
+            lists: vec![VecDeque::new(); max_cost as usize + 1],
             cur: 0,
         },
         Queue::Heap => Open::Heap(BinaryHeap::new()),
     };
-    let h0 = heur.steps(&p.start);
-    open.push(heur.cost(h0), h0, 0);
+    open.push(heur.cost(heur.steps(&p.start)), 0);
     let mut expanded = 0usize;
     let mut goal_node = None;
     // The start must be free for some contact's body; each step checks its own body.
@@ -503,7 +501,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     needs_transit,
                     transit: NONE,
                 });
-                open.push(f, hs, (nodes.len() - 1) as u32);
+                open.push(f, (nodes.len() - 1) as u32);
             }
         }
     }
