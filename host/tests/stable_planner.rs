@@ -541,3 +541,54 @@ fn swept_shape_test_agrees_with_conservative_advancement() {
         );
     }
 }
+
+/// A scene in the shared format (`pushbot_sim::Scene`, with a `[stable]` section) gives the
+/// same problem as the stable-format preset it copies: same plan cost and search.
+#[test]
+fn shared_format_scene_plans_like_the_preset() {
+    let preset = load_scene("fig15").unwrap();
+    let raw: Vec<V2> = preset.objects[0]
+        .polygon
+        .iter()
+        .map(|p| V2::new(p[0], p[1]))
+        .collect();
+    let c = pushbot::mechanics::centroid(&raw);
+    let outline: Vec<[f64; 2]> = raw.iter().map(|p| [p.x - c.x, p.y - c.y]).collect();
+    let (s, g) = (preset.task.start, preset.task.goal);
+    let mut text = format!(
+        "name = \"fig15-shared\"\n[table]\nwidth = {}\nheight = {}\n",
+        preset.table[0], preset.table[1]
+    );
+    for o in &preset.obstacles {
+        text += &format!("[[obstacles]]\noutline = {:?}\n", o.polygon);
+    }
+    text += &format!(
+        "[[objects]]\nid = \"slider\"\noutline = {outline:?}\npose = {{ x = {}, y = {}, theta = {} }}\nmass = 0.1\nsupport_friction = 0.3\npusher_friction = {}\n\
+         [[goals]]\nobject = \"slider\"\npose = {{ x = {}, y = {}, theta = {} }}\n\
+         [stable]\nobject = \"slider\"\nedges = [0]\ngoal_xy_frac = {}\ngoal_theta_deg = {}\n\
+         pusher = {{ kind = \"car\", width = 0.2, depth = 0.18, axle_offset = 0.15, min_turning_radius = 0.3 }}\n\
+         planner = {{ a = 1, b = 5, c = \"inf\", step_frac = 0.3, grid_xy_frac = 1.0, grid_theta_deg = 6.0, fine_radius_frac = 1.0, fine_factor = 3.0, max_cost = 3000, max_nodes = 300000 }}\n",
+        s[0],
+        s[1],
+        s[2].to_radians(),
+        preset.mu,
+        g[0],
+        g[1],
+        g[2].to_radians(),
+        preset.task.goal_xy_frac,
+        preset.task.goal_theta_deg,
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("fig15-shared.toml");
+    std::fs::write(&path, &text).unwrap();
+    let shared = load_scene(path.to_str().unwrap()).unwrap();
+    let a = plan(&preset.problem(CostOverride::default()).unwrap());
+    let b = plan(&shared.problem(CostOverride::default()).unwrap());
+    assert!(a.found && b.found);
+    assert_eq!((a.cost, a.pushes), (b.cost, b.pushes));
+    // A field error in the [stable] section names the file and the line.
+    std::fs::write(&path, text.replace("edges = [0]", "edges = \"zero\"")).unwrap();
+    let e = format!("{:#}", load_scene(path.to_str().unwrap()).unwrap_err());
+    let line = text.lines().position(|l| l.starts_with("edges")).unwrap() + 1;
+    assert!(e.contains(&format!("fig15-shared.toml:{line}:")), "{e}");
+}

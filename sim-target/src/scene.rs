@@ -47,6 +47,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::robot::Pose;
 
+pub mod stable;
+
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -71,6 +73,9 @@ pub struct Scene {
     /// Named poses (start positions of a layout, waypoints).
     #[serde(default)]
     pub positions: Vec<NamedPose>,
+    /// A stable-pushing task for the host's planner (the sim ignores it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stable: Option<stable::Stable>,
 }
 
 /// The table: a rectangle with its origin at the lower-left corner; its edges are walls.
