@@ -6,7 +6,7 @@ use pushbot::mechanics::stable::stable;
 use pushbot::mechanics::{V2, V3, cor};
 use pushbot::planner::stable::presets::{CostOverride, PRESETS, load_scene, parse_scene};
 use pushbot::planner::stable::pusher::PusherKind;
-use pushbot::planner::stable::search::{Plan, brute_force_cost, exact_goal};
+use pushbot::planner::stable::search::{Heuristic, Plan, brute_force_cost, exact_goal};
 use pushbot::planner::stable::{Pose, Problem, Queue, angle_diff, plan, plan_with};
 
 /// Separating-axis overlap test of two convex polygons (closed: touching overlaps).
@@ -470,4 +470,125 @@ kind = "arm"
         .to_string();
     assert!(e.contains("task.start"), "{e}");
     let _ = Pose::new(0.0, 0.0, 0.0);
+}
+
+/// The A* bound never exceeds the number of steps a found plan still takes (admissibility),
+/// from every configuration along the plan, on every preset.
+#[test]
+fn heuristic_is_a_lower_bound_along_found_plans() {
+    for name in PRESETS {
+        let p = load_scene(name)
+            .unwrap()
+            .problem(CostOverride::default())
+            .unwrap();
+        let pl = plan(&p);
+        assert!(pl.found, "{name}");
+        let h = Heuristic::new(&p);
+        let n = pl.steps.len();
+        for (i, s) in pl.steps.iter().enumerate() {
+            let b = h.steps(&s.from);
+            assert!(
+                b as usize <= n - i,
+                "{name}: step {i}: bound {b} > {}",
+                n - i
+            );
+        }
+        // And it is not trivial: from the start it needs a good part of the plan's steps.
+        let b0 = h.steps(&p.start) as usize;
+        assert!(b0 >= 3 && b0 <= n, "{name}: bound {b0} of {n} steps");
+    }
+}
+
+/// The precomputed swept-shape test gives the same answer as conservative advancement, for
+/// steps of every control from configurations scattered over the table (many near obstacles).
+#[test]
+fn swept_shape_test_agrees_with_conservative_advancement() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    for name in ["fig13", "fig16", "fig18"] {
+        let p = load_scene(name)
+            .unwrap()
+            .problem(CostOverride::default())
+            .unwrap();
+        let (w, h) = p.world.table;
+        let (mut free, mut blocked) = (0, 0);
+        for _ in 0..1500 {
+            let q = Pose::new(
+                rng.random_range(0.0..w),
+                rng.random_range(0.0..h),
+                rng.random_range(-3.2..3.2),
+            );
+            for cm in &p.contacts {
+                if !cm.body.free_at(&p.world, &q) {
+                    continue;
+                }
+                for (k, xi) in cm.steps.iter().enumerate() {
+                    let a = cm.body.step_free(&p.world, &q, xi);
+                    let b = cm.body.step_free_swept(&p.world, &q, xi, &cm.swept[k]);
+                    assert_eq!(a, b, "{name}: q {q:?} control {k}");
+                    if a { free += 1 } else { blocked += 1 }
+                }
+                for (k, xi) in cm.fine_steps.iter().enumerate() {
+                    let a = cm.body.step_free(&p.world, &q, xi);
+                    let b = cm.body.step_free_swept(&p.world, &q, xi, &cm.fine_swept[k]);
+                    assert_eq!(a, b, "{name}: q {q:?} fine control {k}");
+                }
+            }
+        }
+        assert!(
+            free > 100 && blocked > 50,
+            "{name}: {free} free, {blocked} blocked"
+        );
+    }
+}
+
+/// A scene in the shared format (`pushbot_sim::Scene`, with a `[stable]` section) gives the
+/// same problem as the stable-format preset it copies: same plan cost and search.
+#[test]
+fn shared_format_scene_plans_like_the_preset() {
+    let preset = load_scene("fig15").unwrap();
+    let raw: Vec<V2> = preset.objects[0]
+        .polygon
+        .iter()
+        .map(|p| V2::new(p[0], p[1]))
+        .collect();
+    let c = pushbot::mechanics::centroid(&raw);
+    let outline: Vec<[f64; 2]> = raw.iter().map(|p| [p.x - c.x, p.y - c.y]).collect();
+    let (s, g) = (preset.task.start, preset.task.goal);
+    let mut text = format!(
+        "name = \"fig15-shared\"\n[table]\nwidth = {}\nheight = {}\n",
+        preset.table[0], preset.table[1]
+    );
+    for o in &preset.obstacles {
+        text += &format!("[[obstacles]]\noutline = {:?}\n", o.polygon);
+    }
+    text += &format!(
+        "[[objects]]\nid = \"slider\"\noutline = {outline:?}\npose = {{ x = {}, y = {}, theta = {} }}\nmass = 0.1\nsupport_friction = 0.3\npusher_friction = {}\n\
+         [[goals]]\nobject = \"slider\"\npose = {{ x = {}, y = {}, theta = {} }}\n\
+         [stable]\nobject = \"slider\"\nedges = [0]\ngoal_xy_frac = {}\ngoal_theta_deg = {}\n\
+         pusher = {{ kind = \"car\", width = 0.2, depth = 0.18, axle_offset = 0.15, min_turning_radius = 0.3 }}\n\
+         planner = {{ a = 1, b = 5, c = \"inf\", step_frac = 0.3, grid_xy_frac = 1.0, grid_theta_deg = 6.0, fine_radius_frac = 1.0, fine_factor = 3.0, max_cost = 3000, max_nodes = 300000 }}\n",
+        s[0],
+        s[1],
+        s[2].to_radians(),
+        preset.mu,
+        g[0],
+        g[1],
+        g[2].to_radians(),
+        preset.task.goal_xy_frac,
+        preset.task.goal_theta_deg,
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("fig15-shared.toml");
+    std::fs::write(&path, &text).unwrap();
+    let shared = load_scene(path.to_str().unwrap()).unwrap();
+    let a = plan(&preset.problem(CostOverride::default()).unwrap());
+    let b = plan(&shared.problem(CostOverride::default()).unwrap());
+    assert!(a.found && b.found);
+    assert_eq!((a.cost, a.pushes), (b.cost, b.pushes));
+    // A field error in the [stable] section names the file and the line.
+    std::fs::write(&path, text.replace("edges = [0]", "edges = \"zero\"")).unwrap();
+    let e = format!("{:#}", load_scene(path.to_str().unwrap()).unwrap_err());
+    let line = text.lines().position(|l| l.starts_with("edges")).unwrap() + 1;
+    assert!(e.contains(&format!("fig15-shared.toml:{line}:")), "{e}");
 }

@@ -13,10 +13,12 @@
 
 pub mod encoder;
 pub mod faults;
+pub mod geometry;
 pub mod motor;
 pub mod presets;
 pub mod pty;
 pub mod pushing;
+pub mod quasistatic;
 pub mod robot;
 pub mod scene;
 pub mod sim;

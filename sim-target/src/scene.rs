@@ -50,6 +50,7 @@ use crate::robot::Pose;
 pub mod camera;
 pub use camera::CameraSpec;
 pub mod rearrange;
+pub mod stable;
 
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -81,6 +82,9 @@ pub struct Scene {
     /// Grid rearrangement planning settings (see [`rearrange`]); the simulator ignores them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rearrange: Option<rearrange::Rearrange>,
+    /// A stable-pushing task for the host's planner (the sim ignores it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stable: Option<stable::Stable>,
 }
 
 /// The table: a rectangle with its origin at the lower-left corner; its edges are walls.
@@ -111,6 +115,8 @@ pub struct RobotSpec {
     pub stall_torque: f64,
     /// True start pose.
     pub start: Pose,
+    /// A flat front bumper plate (`{ width, offset }`, m); none: the round bumper only.
+    pub front_plate: Option<crate::world::FrontPlate>,
 }
 
 impl Default for RobotSpec {
@@ -125,6 +131,7 @@ impl Default for RobotSpec {
             no_load_speed: m.no_load_speed(),
             stall_torque: m.stall_torque(),
             start: Pose::new(0.2, 0.2, 0.0),
+            front_plate: None,
         }
     }
 }

@@ -96,6 +96,7 @@ impl SimOptions {
                 positions: Vec::new(),
                 camera: crate::scene::CameraSpec::default(),
                 rearrange: None,
+                stable: None,
             },
         }
     }

@@ -1,22 +1,31 @@
-//! The world of the first cut: a robot on a table bounded by walls.
+//! The world: a robot on a table bounded by walls, with static obstacles and objects to push.
 //!
-//! Each step the motors drive the wheels as if they rolled (the wheels carry the body's mass),
-//! the body moves along the arc of the resulting twist, and then the walls act: the motion
-//! component into a wall the bumper touches is removed, so nothing ever penetrates a wall (the
-//! body may slide along it). A wheel whose rolling speed no longer matches the body's motion is
-//! held by its traction: it stalls (turns with the body) while the motor torque needed to hold it
-//! is within traction, and otherwise slips, spinning on the table against kinetic friction. A
-//! bumper switch closes while a wall presses on the bumper within its sector, i.e. while the
-//! motion into that wall is being blocked.
+//! Each step the motors drive the wheels as if they rolled (the wheels carry the body's mass)
+//! and the body would move along the arc of the resulting twist. Then every contact acts at
+//! once ([`crate::quasistatic`]): the robot pushes objects quasi-statically (the ellipsoidal
+//! limit surface of Lynch & Mason §3), objects push each other and rest against walls and
+//! obstacles, and the robot's motion is cut back to what the world makes room for, so nothing
+//! ever interpenetrates. Shapes and contact points come from `parry2d` ([`crate::geometry`]).
+//! A wheel whose rolling speed no longer matches the body's motion is held by its traction: it
+//! stalls (turns with the body) while the motor torque needed to hold it is within traction,
+//! and otherwise slips, spinning on the table against kinetic friction. A bumper switch closes
+//! while something presses on the bumper within its sector: on the round bumper by the angle
+//! of the press, on a flat front plate ([`FrontPlate`]) by where along the plate it presses.
 
 use anyhow::{Result, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{ContactPoint, Outline};
 use crate::motor::{Motor, MotorParams, advance_with_friction};
-use crate::pushing::{ContactMode, Slider, closest_boundary_point, point_in_polygon};
-use crate::robot::{Pose, arc_displacement, switches_for_angle, twist_from_wheels, wrap_angle};
-use crate::scene::{Scene, placed, segments_intersect};
+use crate::pushing::Slider;
+use crate::quasistatic::{BodyRef, Drive, Mobile, Row, solve};
+use crate::robot::{
+    Pose, arc_displacement, switch, switches_for_angle, twist_from_wheels, wrap_angle,
+};
+use crate::scene::Scene;
 
 /// Standard gravity, m/s².
 const G: f64 = 9.81;
@@ -30,6 +39,62 @@ pub struct Body {
     pub wheel_radius: f64,
     /// Bumper radius around the axle centre.
     pub bumper_radius: f64,
+    /// A flat plate across the front, if fitted (default: the round bumper only).
+    pub front_plate: Option<FrontPlate>,
+}
+
+/// A flat bumper plate across the robot's front: a straight plate `width` m wide,
+/// perpendicular to the heading, its face `offset` m ahead of the wheel axis (centred on the
+/// heading). The robot's outline is the round body plus the plate (a plate
+/// [`FrontPlate::THICKNESS`] thick behind its face). Objects pushed flat against it touch it
+/// along a line (line contact, Lynch & Mason §2). Its switches close by where it is pressed:
+/// the right switch for presses on its right part (from the right end to `width/8` right of
+/// centre), the centre switch within `width/4` of the centre, the left switch on its left part
+/// (the zones overlap, like the round bumper's sectors); a flush press spanning the plate
+/// closes all three.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrontPlate {
+    /// Plate width, m.
+    pub width: f64,
+    /// Distance of the plate's face ahead of the wheel axis, m.
+    pub offset: f64,
+}
+
+impl FrontPlate {
+    /// Thickness of the plate behind its face, m.
+    pub const THICKNESS: f64 = 0.004;
+
+    /// The plate's outline in the robot frame (x ahead, y to the left).
+    pub fn outline(&self) -> [[f64; 2]; 4] {
+        let (h, f, b) = (self.width / 2.0, self.offset, self.offset - Self::THICKNESS);
+        [[b, -h], [f, -h], [f, h], [b, h]]
+    }
+
+    /// Whether the plate is usable: finite, positive width, face ahead of the axis.
+    pub fn valid(&self) -> bool {
+        self.width.is_finite()
+            && self.offset.is_finite()
+            && self.width > 0.0
+            && self.offset > Self::THICKNESS
+    }
+
+    /// The switches closed by presses spanning lateral positions `lo..=hi` (m, left positive).
+    pub fn switches(&self, lo: f64, hi: f64) -> u8 {
+        let w = self.width;
+        let hit = |a: f64, b: f64| hi >= a && lo <= b;
+        let mut bits = 0;
+        if hit(-w / 4.0, w / 4.0) {
+            bits |= switch::CENTRE;
+        }
+        if hit(w / 8.0, f64::INFINITY) {
+            bits |= switch::LEFT;
+        }
+        if hit(f64::NEG_INFINITY, -w / 8.0) {
+            bits |= switch::RIGHT;
+        }
+        bits
+    }
 }
 
 impl Body {
@@ -39,9 +104,29 @@ impl Body {
             wheel_base: f64::from(g.wheel_base),
             wheel_radius: f64::from(g.wheel_radius),
             bumper_radius: f64::from(g.bumper_radius),
+            front_plate: None,
+        }
+    }
+
+    /// The robot's outline (robot frame): the round bumper, plus the plate if fitted.
+    pub fn outline(&self) -> Result<Outline> {
+        let disc = Outline::disc(self.bumper_radius);
+        match self.front_plate {
+            None => Ok(disc),
+            Some(p) if p.valid() => Ok(disc.with_convex_part(&p.outline())?),
+            Some(p) => {
+                bail!("front plate {p:?} needs a positive width and its face ahead of the axle")
+            }
         }
     }
 }
+
+/// Coulomb coefficient between two objects.
+pub const OBJECT_FRICTION: f64 = 0.3;
+/// Coulomb coefficient between an object and a wall or obstacle.
+pub const WALL_FRICTION: f64 = 0.2;
+/// Support-friction load `μ_s·m·g` (N) of objects added without one ([`World::add_object`]).
+pub const DEFAULT_LOAD: f64 = 0.7;
 
 /// The physical model's constants and noise levels (all noise is drawn from the seed).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -102,6 +187,14 @@ pub struct World {
     rng: ChaCha8Rng,
     obstacles: Vec<Vec<[f64; 2]>>,
     objects: Vec<(String, Slider)>,
+    /// The robot's outline, robot frame.
+    shape: Outline,
+    /// Walls (half-planes beyond the table's edges) and obstacles: outline, pose, bounding box.
+    statics: Vec<(Outline, Pose, [f64; 4])>,
+    /// Each object's outline (object frame) and support-friction load μ_s·m·g, N.
+    object_shapes: Vec<(Outline, f64)>,
+    /// Scratch: contacts of the step.
+    contacts: Vec<ContactPoint>,
 }
 
 impl World {
@@ -129,6 +222,7 @@ impl World {
                 start.theta
             );
         }
+        let shape = body.outline()?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let s = hw.motor_gain_spread.abs();
         let mut motor = || {
@@ -158,7 +252,7 @@ impl World {
                 limit: -r,
             },
         ];
-        Ok(World {
+        World {
             table,
             walls,
             body,
@@ -170,11 +264,45 @@ impl World {
             rng,
             obstacles: Vec::new(),
             objects: Vec::new(),
-        })
+            shape,
+            statics: Vec::new(),
+            object_shapes: Vec::new(),
+            contacts: Vec::new(),
+        }
+        .with_walls()
     }
 
-    /// The world of a scene: its table, obstacles and objects, the robot at its start pose.
-    pub fn from_scene(scene: &Scene, body: Body, hw: Hardware, seed: u64) -> Result<Self> {
+    /// The four walls: half-planes beyond the table's edges. Fails if the robot's outline
+    /// (its plate) starts beyond them.
+    fn with_walls(mut self) -> Result<Self> {
+        let (w, h) = self.table;
+        let (inf, ninf) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (normal, at, bb) in [
+            ([1.0, 0.0], Pose::new(0.0, 0.0, 0.0), [ninf, ninf, 0.0, inf]),
+            ([-1.0, 0.0], Pose::new(w, 0.0, 0.0), [w, ninf, inf, inf]),
+            ([0.0, 1.0], Pose::new(0.0, 0.0, 0.0), [ninf, ninf, inf, 0.0]),
+            ([0.0, -1.0], Pose::new(0.0, h, 0.0), [ninf, h, inf, inf]),
+        ] {
+            self.statics.push((Outline::half_plane(normal), at, bb));
+        }
+        if self.robot_overlaps_statics() {
+            bail!("the robot's outline at its start pose leaves the table");
+        }
+        Ok(self)
+    }
+
+    fn robot_overlaps_statics(&self) -> bool {
+        self.statics
+            .iter()
+            .any(|(o, at, _)| self.shape.overlaps(&self.pose, o, at, 1e-12))
+    }
+
+    /// The world of a scene: its table, obstacles and objects, the robot at its start pose
+    /// (with the scene's front plate if `body` has none).
+    pub fn from_scene(scene: &Scene, mut body: Body, hw: Hardware, seed: u64) -> Result<Self> {
+        if body.front_plate.is_none() {
+            body.front_plate = scene.robot.front_plate;
+        }
         let mut w = World::new(
             (scene.table.width, scene.table.height),
             scene.robot.start,
@@ -186,42 +314,79 @@ impl World {
             w.add_obstacle(o.outline.clone())?;
         }
         for o in &scene.objects {
-            w.add_object(&o.id, Slider::from_object(o))?;
+            let load = o.support_friction * o.mass * G;
+            w.add_object_with_load(&o.id, Slider::from_object(o), load)?;
         }
         Ok(w)
     }
 
-    /// Add a static obstacle (table frame polygon). Fails if it overlaps the robot.
+    /// Add a static obstacle (table frame polygon, simple). Fails if it is not a usable
+    /// polygon or overlaps the robot or an object.
     pub fn add_obstacle(&mut self, outline: Vec<[f64; 2]>) -> Result<()> {
-        if outline.len() < 3 {
-            bail!("an obstacle needs at least 3 vertices");
+        let shape = Outline::polygon(&outline)?;
+        let mut bb = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for v in &outline {
+            bb = [
+                bb[0].min(v[0]),
+                bb[1].min(v[1]),
+                bb[2].max(v[0]),
+                bb[3].max(v[1]),
+            ];
         }
-        if circle_overlaps(
-            &outline,
-            [self.pose.x, self.pose.y],
-            self.body.bumper_radius,
-        ) {
+        let origin = Pose::default();
+        if self.shape.overlaps(&self.pose, &shape, &origin, 1e-12) {
             bail!("an obstacle overlaps the robot's start pose");
         }
+        for ((id, s), (o, _)) in self.objects.iter().zip(&self.object_shapes) {
+            if o.overlaps(&s.pose, &shape, &origin, 1e-12) {
+                bail!("an obstacle overlaps object {id:?}");
+            }
+        }
         self.obstacles.push(outline);
+        self.statics.push((shape, origin, bb));
         Ok(())
     }
 
-    /// Add a pushable object. Fails if it overlaps the robot, an obstacle, another object or
-    /// leaves the table.
+    /// Add a pushable object with the default support-friction load ([`DEFAULT_LOAD`]).
+    /// Fails if it overlaps the robot, an obstacle, another object or leaves the table.
     pub fn add_object(&mut self, id: &str, slider: Slider) -> Result<()> {
-        let outline = placed(&slider.outline, &slider.pose);
-        if circle_overlaps(
-            &outline,
-            [self.pose.x, self.pose.y],
-            self.body.bumper_radius,
-        ) {
+        self.add_object_with_load(id, slider, DEFAULT_LOAD)
+    }
+
+    /// Add a pushable object whose support friction is `load = μ_s·m·g` newtons (it sets how
+    /// objects pushed together share the push). Fails if its outline is not a usable polygon,
+    /// or it overlaps the robot, an obstacle, another object or leaves the table.
+    pub fn add_object_with_load(&mut self, id: &str, slider: Slider, load: f64) -> Result<()> {
+        if !(load.is_finite() && load > 0.0) {
+            bail!("object {id:?}: the support-friction load must be positive");
+        }
+        if !(slider.c.is_finite() && slider.c > 0.0 && slider.mu.is_finite() && slider.mu >= 0.0) {
+            bail!("object {id:?}: needs a positive limit-surface length and a friction ≥ 0");
+        }
+        let shape =
+            Outline::polygon(&slider.outline).map_err(|e| anyhow::anyhow!("object {id:?}: {e}"))?;
+        if shape.overlaps(&slider.pose, &self.shape, &self.pose, 1e-12) {
             bail!("object {id:?} overlaps the robot's start pose");
         }
-        if self.polygon_blocked(&outline, None) {
-            bail!("object {id:?} overlaps an obstacle, another object or the table's edge");
+        if self
+            .statics
+            .iter()
+            .any(|(o, at, _)| shape.overlaps(&slider.pose, o, at, 1e-12))
+        {
+            bail!("object {id:?} overlaps an obstacle or leaves the table");
+        }
+        for ((other, s), (o, _)) in self.objects.iter().zip(&self.object_shapes) {
+            if shape.overlaps(&slider.pose, o, &s.pose, 1e-12) {
+                bail!("object {id:?} overlaps object {other:?}");
+            }
         }
         self.objects.push((id.to_owned(), slider));
+        self.object_shapes.push((shape, load));
         Ok(())
     }
 
@@ -235,87 +400,238 @@ impl World {
         &self.obstacles
     }
 
-    /// Whether a placed polygon leaves the table or overlaps an obstacle or another object
-    /// (other than the object with index `skip`).
-    fn polygon_blocked(&self, outline: &[[f64; 2]], skip: Option<usize>) -> bool {
-        self.statically_blocked(outline)
-            || !self
-                .overlapping_objects(outline, &[skip.unwrap_or(usize::MAX)])
-                .is_empty()
+    /// The robot's outline (robot frame; place it at [`World::pose`]).
+    pub fn robot_outline(&self) -> &Outline {
+        &self.shape
     }
 
-    /// Whether a placed polygon leaves the table or overlaps an obstacle.
-    fn statically_blocked(&self, outline: &[[f64; 2]]) -> bool {
-        let (w, h) = self.table;
-        outline
-            .iter()
-            .any(|v| v[0] < 0.0 || v[0] > w || v[1] < 0.0 || v[1] > h)
-            || self.obstacles.iter().any(|o| polygons_overlap(o, outline))
+    /// Object `k`'s outline (object frame; place it at its slider's pose).
+    pub fn object_outline(&self, k: usize) -> Option<&Outline> {
+        self.object_shapes.get(k).map(|(o, _)| o)
     }
 
-    /// Indices of the objects (except those in `skip`) a placed polygon overlaps.
-    fn overlapping_objects(&self, outline: &[[f64; 2]], skip: &[usize]) -> Vec<usize> {
+    /// The deepest interpenetration between any two bodies (robot, objects, walls,
+    /// obstacles), m; 0 when nothing overlaps.
+    pub fn max_penetration(&self) -> f64 {
+        let mut worst = 0.0f64;
+        for (k, ((_, s), (o, _))) in self.objects.iter().zip(&self.object_shapes).enumerate() {
+            worst = worst.max(self.shape.depth(&self.pose, o, &s.pose));
+            for (st, at, _) in &self.statics {
+                worst = worst.max(o.depth(&s.pose, st, at));
+            }
+            for ((_, s2), (o2, _)) in self.objects.iter().zip(&self.object_shapes).skip(k + 1) {
+                worst = worst.max(o.depth(&s.pose, o2, &s2.pose));
+            }
+        }
+        for (st, at, _) in &self.statics {
+            worst = worst.max(self.shape.depth(&self.pose, st, at));
+        }
+        worst
+    }
+
+    /// Gather the contacts closer than `prediction` between the robot at `robot`, the objects
+    /// and the static bodies, as solver rows. Objects whose index is in `only` (all if `None`)
+    /// and the robot take part.
+    fn rows(&mut self, robot: &Pose, prediction: f64, with_robot: bool) -> Vec<Row> {
+        let mut rows = Vec::new();
+        let r_robot = self.shape.radius();
+        let near = |bb: &[f64; 4], p: &Pose, r: f64| {
+            p.x + r + prediction >= bb[0]
+                && p.x - r - prediction <= bb[2]
+                && p.y + r + prediction >= bb[1]
+                && p.y - r - prediction <= bb[3]
+        };
+        let push = |rows: &mut Vec<Row>, cs: &mut Vec<ContactPoint>, a, b, mu| {
+            for c in cs.drain(..) {
+                rows.push(Row {
+                    a,
+                    b,
+                    pa: c.pa,
+                    pb: c.pb,
+                    n: c.normal,
+                    gap: c.dist,
+                    mu,
+                });
+            }
+        };
+        let mut cs = std::mem::take(&mut self.contacts);
+        if with_robot {
+            for (st, at, bb) in &self.statics {
+                if near(bb, robot, r_robot) {
+                    self.shape.contacts(robot, st, at, prediction, &mut cs);
+                    push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Static, 0.0);
+                }
+            }
+        }
+        for (k, ((_, s), (o, _))) in self.objects.iter().zip(&self.object_shapes).enumerate() {
+            if with_robot {
+                self.shape.contacts(robot, o, &s.pose, prediction, &mut cs);
+                push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Object(k), s.mu);
+            }
+            for (st, at, bb) in &self.statics {
+                if near(bb, &s.pose, o.radius()) {
+                    o.contacts(&s.pose, st, at, prediction, &mut cs);
+                    push(
+                        &mut rows,
+                        &mut cs,
+                        BodyRef::Object(k),
+                        BodyRef::Static,
+                        WALL_FRICTION,
+                    );
+                }
+            }
+            for (j, ((_, s2), (o2, _))) in self
+                .objects
+                .iter()
+                .zip(&self.object_shapes)
+                .enumerate()
+                .skip(k + 1)
+            {
+                o.contacts(&s.pose, o2, &s2.pose, prediction, &mut cs);
+                push(
+                    &mut rows,
+                    &mut cs,
+                    BodyRef::Object(k),
+                    BodyRef::Object(j),
+                    OBJECT_FRICTION,
+                );
+            }
+        }
+        self.contacts = cs;
+        rows
+    }
+
+    fn mobiles(&self) -> Vec<Mobile> {
         self.objects
             .iter()
-            .enumerate()
-            .filter(|(k, (_, s))| {
-                !skip.contains(k) && polygons_overlap(&placed(&s.outline, &s.pose), outline)
+            .zip(&self.object_shapes)
+            .map(|((_, s), (_, load))| Mobile {
+                cof: s.cof_on_table(),
+                c: s.c,
+                s: 1.0 / load,
             })
-            .map(|(k, _)| k)
             .collect()
     }
 
-    /// Object `k` moved from `before` into object `j`: let `k` push `j` quasi-statically at the
-    /// mean of `k`'s vertices that entered `j` (a point pusher moving with `k`), then back `j`
-    /// out of `k`. Returns false (and restores `j`) if `j` cannot move there.
-    ///
-    /// Simplification: `k`'s own motion is computed as if pushed alone; `j` follows it.
-    fn chain_push(&mut self, k: usize, before: &Slider, j: usize) -> bool {
-        let saved_j = self.objects[j].1.clone();
-        let after = self.objects[k].1.clone();
-        let inside: Vec<[f64; 2]> = placed(&after.outline, &after.pose)
-            .into_iter()
-            .filter(|v| point_in_polygon(saved_j.to_local(*v), &saved_j.outline))
-            .collect();
-        if inside.is_empty() {
-            return false;
+    /// Move the objects by the solve's displacements (COF, table frame).
+    fn move_objects(&mut self, moves: &[[f64; 3]]) {
+        for ((_, s), m) in self.objects.iter_mut().zip(moves) {
+            if m == &[0.0; 3] {
+                continue;
+            }
+            let cof = s.cof_on_table();
+            let theta = s.pose.theta + m[2];
+            let (sn, cs) = theta.sin_cos();
+            let off = [cs * s.cof[0] - sn * s.cof[1], sn * s.cof[0] + cs * s.cof[1]];
+            s.pose = Pose::new(
+                cof[0] + m[0] - off[0],
+                cof[1] + m[1] - off[1],
+                wrap_angle(theta),
+            );
         }
-        let m = inside.len() as f64;
-        let c_after = [
-            inside.iter().map(|v| v[0]).sum::<f64>() / m,
-            inside.iter().map(|v| v[1]).sum::<f64>() / m,
-        ];
-        let c_before = before.to_table(after.to_local(c_after));
-        self.objects[j].1.push(c_before, c_after, 0.0, 5e-4);
-        // Back j out of k: move it so that k's deepest vertex inside it is on its boundary.
+    }
+
+    /// The robot would move by `(dx, dy, dth)`: let every contact act (see [`crate::quasistatic`]),
+    /// move the objects, and return the robot's feasible motion, whether it was cut back, and
+    /// set the bumper switches.
+    fn resolve_contacts(&mut self, dx: f64, dy: f64, dth: f64) -> (f64, f64, f64, bool) {
+        let reach = (dx * dx + dy * dy).sqrt() + dth.abs() * self.shape.radius();
+        let prediction = 2.0 * reach + 1e-4;
+        let pose = self.pose;
+        let rows = self.rows(&pose, prediction, true);
+        if rows.is_empty() {
+            self.pressed = 0;
+            return (dx, dy, dth, false);
+        }
+        let mobiles = self.mobiles();
+        let drive = Drive {
+            centre: [pose.x, pose.y],
+            d: [dx, dy],
+            dth,
+        };
+        let sol = solve(&mobiles, &rows, &drive);
+        self.move_objects(&sol.moves);
+        let k = sol.scale;
+        let (ax, ay, dth2) = (k * dx, k * dy, k * dth);
+        // Second-order corrections: the linearised step may leave a body a hair inside
+        // something (an object turned). Push it back out; here the robot is a very stiff
+        // mobile body too, so that an object wedged between it and a wall can push it back.
+        let (mut ax, mut ay, mut dth2) = (ax, ay, dth2);
+        let mut after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
         for _ in 0..4 {
-            let sj = &self.objects[j].1;
-            let mut deepest: Option<([f64; 2], f64)> = None;
-            for v in placed(&after.outline, &after.pose) {
-                let local = sj.to_local(v);
-                if point_in_polygon(local, &sj.outline) {
-                    let (cp, d) = closest_boundary_point(local, &sj.outline);
-                    if deepest.is_none_or(|(_, dd)| d > dd) {
-                        let shift = sj.to_table(local);
-                        let cpt = sj.to_table(cp);
-                        deepest = Some(([shift[0] - cpt[0], shift[1] - cpt[1]], d));
+            let mut fix = self.rows(&after, 0.0, true);
+            if fix.iter().all(|r| r.gap >= -1e-12) {
+                break;
+            }
+            let mut m = self.mobiles();
+            let robot = m.len();
+            let stiff = m.iter().map(|b| b.s).fold(f64::INFINITY, f64::min) * 1e-2;
+            m.push(Mobile {
+                cof: [after.x, after.y],
+                c: self.shape.radius(),
+                s: if stiff.is_finite() { stiff } else { 1e-3 },
+            });
+            for r in &mut fix {
+                for b in [&mut r.a, &mut r.b] {
+                    if *b == BodyRef::Robot {
+                        *b = BodyRef::Object(robot);
                     }
                 }
             }
-            let Some((shift, _)) = deepest else { break };
-            let sj = &mut self.objects[j].1;
-            // A hair further, so that the two outlines do not stay crossed by rounding.
-            sj.pose.x += shift[0] * (1.0 + 1e-9);
-            sj.pose.y += shift[1] * (1.0 + 1e-9);
+            let s = crate::quasistatic::solve(&m, &fix, &Drive::default());
+            self.move_objects(&s.moves[..robot]);
+            let [rx, ry, rth] = s.moves[robot];
+            ax += rx;
+            ay += ry;
+            dth2 += rth;
+            after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
         }
-        let moved_j = placed(&self.objects[j].1.outline, &self.objects[j].1.pose);
-        if self.statically_blocked(&moved_j)
-            || !self.overlapping_objects(&moved_j, &[j, k]).is_empty()
+        self.pressed = self.presses(&rows, &sol, &drive, &after);
+        (ax, ay, dth2, k < 1.0 - 1e-12)
+    }
+
+    /// Which bumper switches the step's contacts close: those of the robot's contacts that
+    /// carry force, or that the commanded motion drives into while touching.
+    fn presses(
+        &self,
+        rows: &[Row],
+        sol: &crate::quasistatic::Solution,
+        drive: &Drive,
+        after: &Pose,
+    ) -> u8 {
+        let mut bits = 0;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (sn, cs) = after.theta.sin_cos();
+        for (i, r) in rows.iter().enumerate() {
+            if r.a != BodyRef::Robot {
+                continue;
+            }
+            let u = [
+                drive.d[0] - drive.dth * (r.pa[1] - drive.centre[1]),
+                drive.d[1] + drive.dth * (r.pa[0] - drive.centre[0]),
+            ];
+            let into = r.n[0] * u[0] + r.n[1] * u[1];
+            let closes = r.gap - into <= 1e-9 && into > 0.0;
+            if !(sol.normal[i] > 0.0 || closes) {
+                continue;
+            }
+            // The press point relative to the robot, robot frame.
+            let rel = [r.pa[0] - drive.centre[0], r.pa[1] - drive.centre[1]];
+            let local = [cs * rel[0] + sn * rel[1], -sn * rel[0] + cs * rel[1]];
+            match self.body.front_plate {
+                Some(p) if local[0] >= p.offset - FrontPlate::THICKNESS - 1e-9 => {
+                    lo = lo.min(local[1]);
+                    hi = hi.max(local[1]);
+                }
+                _ => bits |= switches_for_angle(r.n[1].atan2(r.n[0]) - after.theta),
+            }
+        }
+        if let Some(p) = self.body.front_plate
+            && lo <= hi
         {
-            self.objects[j].1 = saved_j;
-            return false;
+            bits |= p.switches(lo, hi);
         }
-        true
+        bits
     }
 
     /// Table width and height, m.
@@ -393,74 +709,9 @@ impl World {
         let (v, omega) = twist_from_wheels(rim, b);
         let (dx, dy, dth) = arc_displacement(self.pose.theta, v, omega, dt);
 
-        // 2. The walls remove the motion into them.
-        let (mut ax, mut ay) = (dx, dy);
-        let mut pressed = 0u8;
-        let mut blocked = false;
-        for w in &self.walls {
-            let (nx, ny) = w.normal;
-            let reach = nx * (self.pose.x + ax) + ny * (self.pose.y + ay);
-            if reach > w.limit {
-                // Remove exactly the excess along the normal: the centre ends on the limit.
-                let excess = reach - w.limit;
-                ax -= excess * nx;
-                ay -= excess * ny;
-                blocked = true;
-                pressed |= switches_for_angle(ny.atan2(nx) - self.pose.theta);
-            }
-        }
-
-        // 2b. Static obstacles, like walls: the motion into them is removed.
+        // 2. Walls, obstacles and objects: one quasi-static solve with every contact.
+        let (ax, ay, dth, blocked) = self.resolve_contacts(dx, dy, dth);
         let r_b = self.body.bumper_radius;
-        for obs in &self.obstacles {
-            let q = [self.pose.x + ax, self.pose.y + ay];
-            if let Some((n, depth)) = circle_penetration(obs, q, r_b) {
-                ax -= n[0] * depth;
-                ay -= n[1] * depth;
-                blocked = true;
-                pressed |= switches_for_angle(n[1].atan2(n[0]) - self.pose.theta);
-            }
-        }
-
-        // 2c. Objects: pushed quasi-statically; one that would run into a wall, an obstacle
-        // or another object stays put and blocks the robot instead.
-        let from = [self.pose.x, self.pose.y];
-        for k in 0..self.objects.len() {
-            let to = [self.pose.x + ax, self.pose.y + ay];
-            if self.objects[k].1.gap(to, r_b) > 0.0 {
-                continue;
-            }
-            let saved = self.objects[k].1.clone();
-            let mode = self.objects[k].1.push(from, to, r_b, 5e-4);
-            let moved = placed(&self.objects[k].1.outline, &self.objects[k].1.pose);
-            let stuck = if self.statically_blocked(&moved) {
-                true
-            } else {
-                match self.overlapping_objects(&moved, &[k])[..] {
-                    [] => false,
-                    [j] => !self.chain_push(k, &saved, j),
-                    _ => true,
-                }
-            };
-            if stuck {
-                self.objects[k].1 = saved;
-            } else if matches!(mode, Some(ContactMode::Sticking | ContactMode::Sliding)) {
-                let s = &self.objects[k].1;
-                let (cp, _) = closest_boundary_point(s.to_local(to), &s.outline);
-                let c = s.to_table(cp);
-                pressed |= switches_for_angle((c[1] - to[1]).atan2(c[0] - to[0]) - self.pose.theta);
-                continue;
-            }
-            // Blocked (or a grazing contact): the robot does not enter the object.
-            let placed_now = placed(&self.objects[k].1.outline, &self.objects[k].1.pose);
-            if let Some((n, depth)) = circle_penetration(&placed_now, to, r_b) {
-                ax -= n[0] * depth;
-                ay -= n[1] * depth;
-                blocked = true;
-                pressed |= switches_for_angle(n[1].atan2(n[0]) - self.pose.theta);
-            }
-        }
-        self.pressed = pressed;
 
         // 3. Wheels against the body's actual motion: roll, stall or slip.
         let mut ground = rolling;
@@ -512,41 +763,12 @@ impl World {
     }
 }
 
-/// If a circle (centre `q`, radius `r`) overlaps a polygon: the unit normal from the centre
-/// towards the polygon and the depth to back out by along it.
-fn circle_penetration(outline: &[[f64; 2]], q: [f64; 2], r: f64) -> Option<([f64; 2], f64)> {
-    let (cp, d) = closest_boundary_point(q, outline);
-    let inside = point_in_polygon(q, outline);
-    if !inside && d >= r {
-        return None;
-    }
-    let mut n = [cp[0] - q[0], cp[1] - q[1]];
-    let len = (n[0] * n[0] + n[1] * n[1]).sqrt();
-    if len < 1e-15 {
-        return None;
-    }
-    n = [n[0] / len, n[1] / len];
-    if inside {
-        // The centre is inside: the boundary point lies behind the motion; back out through it.
-        n = [-n[0], -n[1]];
-        return Some((n, d + r));
-    }
-    Some((n, r - d))
-}
-
-fn circle_overlaps(outline: &[[f64; 2]], q: [f64; 2], r: f64) -> bool {
-    circle_penetration(outline, q, r).is_some_and(|(_, depth)| depth > 1e-12)
-}
-
-/// Whether two simple polygons overlap (edges cross, or one contains the other).
+/// Whether two simple polygons (table frame) overlap by more than a touch (more than 1 nm;
+/// parry2d contacts between their convex parts). Unusable polygons count as overlapping
+/// nothing.
 pub fn polygons_overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> bool {
-    let (na, nb) = (a.len(), b.len());
-    for i in 0..na {
-        for j in 0..nb {
-            if segments_intersect(a[i], a[(i + 1) % na], b[j], b[(j + 1) % nb]) {
-                return true;
-            }
-        }
+    match (Outline::polygon(a), Outline::polygon(b)) {
+        (Ok(a), Ok(b)) => a.overlaps(&Pose::default(), &b, &Pose::default(), 1e-9),
+        _ => false,
     }
-    (!b.is_empty() && point_in_polygon(b[0], a)) || (!a.is_empty() && point_in_polygon(a[0], b))
 }

@@ -214,6 +214,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::
             c,
             opts.kg_per_mass,
         )),
+        stable: None,
     };
     // Round-trip through the checked loader so the scene is one the simulator accepts.
     pushbot_sim::Scene::from_toml(&scene.to_toml(), &format!("grid scene {}", problem.name))

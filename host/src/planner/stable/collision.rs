@@ -2,16 +2,16 @@
 //! obstacles and the table walls, checked along each push step, not only at its end.
 //!
 //! The paper grows a bounding disk of `PS` by the step length and checks only the step's end.
-//! Here `PS` is its real polygons (parry2d convex polygons) and a step — a constant twist in the
+//! Here `PS` is its real polygons (parry2d-f64 convex polygons) and a step — a constant twist in the
 //! slider frame, i.e. a rotation about a fixed centre or a translation — is checked by
 //! *conservative advancement*: at time `t` the distance `d` from `PS(t)` to the obstacles is
 //! measured, and no point of `PS` moves farther than `D·Δt` in `Δt` (`D` = largest arc length
 //! of any vertex over the step), so `PS` cannot touch anything before `t + d/D`. Touching counts
 //! as collision (obstacles are closed).
 
-use parry2d::math::{Pose as PPose, Vector as PVec};
-use parry2d::query;
-use parry2d::shape::ConvexPolygon;
+use parry2d_f64::math::{Pose as PPose, Vector as PVec};
+use parry2d_f64::query;
+use parry2d_f64::shape::ConvexPolygon;
 
 use super::Pose;
 use crate::mechanics::{V2, V3, convex_hull};
@@ -39,10 +39,7 @@ impl std::fmt::Debug for Obstacle {
 
 /// Convert a point list to a parry convex polygon (the convex hull of the points).
 pub fn convex(points: &[V2]) -> Option<ConvexPolygon> {
-    let pts: Vec<PVec> = points
-        .iter()
-        .map(|p| PVec::new(p.x as f32, p.y as f32))
-        .collect();
+    let pts: Vec<PVec> = points.iter().map(|p| PVec::new(p.x, p.y)).collect();
     ConvexPolygon::from_convex_hull(&pts)
 }
 
@@ -106,10 +103,39 @@ impl World {
     }
 }
 
+/// Largest rotation between two samples of a swept shape (rad).
+const SWEPT_SAMPLE_ANGLE: f64 = 0.1;
+
+/// A conservative swept shape, precomputed once per control: the region a [`Body`] covers
+/// while it follows a constant slider-frame twist from the slider frame's identity pose, as
+/// convex parts (one per body part: the hull of the part at sampled poses, grown by the largest
+/// sagitta of the arcs between samples and a small margin). Placed at a configuration `q` it
+/// contains everything the body touches during the step from `q`, so one static overlap test
+/// replaces the sweep when it misses.
+#[derive(Clone)]
+pub struct Swept {
+    parts: Vec<ConvexPolygon>,
+    /// Centre of a disk holding all parts (slider frame).
+    pub centre: V2,
+    /// Radius of that disk.
+    pub radius: f64,
+}
+
+impl std::fmt::Debug for Swept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Swept")
+            .field("centre", &self.centre)
+            .field("radius", &self.radius)
+            .finish()
+    }
+}
+
 /// A rigid body moving with the slider: convex parts in the slider frame.
 #[derive(Clone)]
 pub struct Body {
     parts: Vec<ConvexPolygon>,
+    /// The points of each part (slider frame).
+    part_points: Vec<Vec<V2>>,
     /// All vertices of all parts (slider frame).
     pub vertices: Vec<V2>,
     /// Largest distance of a vertex from the slider frame's origin.
@@ -129,15 +155,18 @@ impl Body {
     pub fn new(parts: &[Vec<V2>]) -> Self {
         let mut shapes = Vec::new();
         let mut vertices = Vec::new();
+        let mut part_points = Vec::new();
         for p in parts {
             if let Some(s) = convex(p) {
                 shapes.push(s);
                 vertices.extend(p.iter().copied());
+                part_points.push(p.clone());
             }
         }
         let radius = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
         Body {
             parts: shapes,
+            part_points,
             vertices,
             radius,
         }
@@ -146,7 +175,7 @@ impl Body {
     /// Smallest distance from the body at `q` to any obstacle whose box is within `reach` of
     /// `q`'s origin (`f64::INFINITY` if none).
     pub fn clearance(&self, world: &World, q: &Pose, reach: f64) -> f64 {
-        let pose = PPose::new(PVec::new(q.x as f32, q.y as f32), q.theta as f32);
+        let pose = PPose::new(PVec::new(q.x, q.y), q.theta);
         let r = self.radius + reach;
         let mut best = f64::INFINITY;
         for o in &world.obstacles {
@@ -154,13 +183,13 @@ impl Body {
             // Distance from the origin to the box; the body lies within `radius` of it.
             let dx = (b[0] - q.x).max(q.x - b[2]).max(0.0);
             let dy = (b[1] - q.y).max(q.y - b[3]).max(0.0);
-            let box_d = dx.hypot(dy);
+            let box_d = (dx * dx + dy * dy).sqrt();
             if box_d > r || box_d - self.radius >= best {
                 continue;
             }
             for part in &self.parts {
                 let d = query::distance(&pose, part, &PPose::identity(), &o.shape)
-                    .map(|d| d.distance as f64)
+                    .map(|d| d.distance)
                     .unwrap_or(0.0);
                 best = best.min(d);
                 if best <= CONTACT_EPS {
@@ -169,6 +198,91 @@ impl Body {
             }
         }
         best
+    }
+
+    /// The swept shape of this body under the slider-frame motion `xi` (see [`Swept`]).
+    pub fn swept(&self, xi: &V3) -> Swept {
+        let phi = xi.z.abs();
+        let (k, sag) = match super::cor_of(xi) {
+            Some(c) => {
+                let k = (phi / SWEPT_SAMPLE_ANGLE).ceil().max(1.0);
+                let rho = self
+                    .vertices
+                    .iter()
+                    .map(|v| (v - c).norm())
+                    .fold(0.0, f64::max);
+                (k as usize, rho * (1.0 - (phi / (2.0 * k)).cos()))
+            }
+            None => (1, 0.0),
+        };
+        // Grow by the sagitta (arcs bulge beyond their chords) and a margin that makes "the
+        // grown hull misses every obstacle" imply "clearance > CONTACT_EPS all along".
+        let grow = (sag + 3.0 * CONTACT_EPS) / (std::f64::consts::PI / 8.0).cos();
+        let mut parts = Vec::new();
+        let mut all = Vec::new();
+        for pts in &self.part_points {
+            let mut cloud = Vec::with_capacity(pts.len() * (k + 1) * 8);
+            for i in 0..=k {
+                let pose = Pose::new(0.0, 0.0, 0.0).integrate(&(xi * (i as f64 / k as f64)));
+                for p in pts {
+                    let w = pose.apply(*p);
+                    for j in 0..8 {
+                        let a = std::f64::consts::PI * (2.0 * j as f64 + 1.0) / 8.0;
+                        cloud.push(w + V2::new(a.cos(), a.sin()) * grow);
+                    }
+                }
+            }
+            let hull = convex_hull(&cloud);
+            if let Some(shape) = convex(&hull) {
+                parts.push(shape);
+                all.extend(hull);
+            }
+        }
+        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+        for p in &all {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let centre = (lo + hi) / 2.0;
+        let radius = all.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+        Swept {
+            parts,
+            centre,
+            radius,
+        }
+    }
+
+    /// As [`Body::step_free`], deciding most steps with one static test of the precomputed
+    /// swept shape `sw` of `xi`: if it misses every obstacle the step is free; else if the body
+    /// touches an obstacle at the step's end the step is not; else conservative advancement
+    /// decides. The answer is the same as [`Body::step_free`]'s.
+    pub fn step_free_swept(&self, world: &World, q: &Pose, xi: &V3, sw: &Swept) -> bool {
+        let c = q.apply(sw.centre);
+        let pose = PPose::new(PVec::new(q.x, q.y), q.theta);
+        let mut hit = false;
+        'obstacles: for o in &world.obstacles {
+            let b = o.bounds;
+            let dx = (b[0] - c.x).max(c.x - b[2]).max(0.0);
+            let dy = (b[1] - c.y).max(c.y - b[3]).max(0.0);
+            if dx * dx + dy * dy > sw.radius * sw.radius {
+                continue;
+            }
+            for part in &sw.parts {
+                if query::intersection_test(&pose, part, &PPose::identity(), &o.shape)
+                    .map_or(true, |i| i.intersecting)
+                {
+                    hit = true;
+                    break 'obstacles;
+                }
+            }
+        }
+        if !hit {
+            return true;
+        }
+        if !self.free_at(world, &q.integrate(xi)) {
+            return false;
+        }
+        self.step_free_from(world, q, xi, None)
     }
 
     /// Whether the body is free at `q`.

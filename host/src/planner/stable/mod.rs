@@ -71,6 +71,16 @@ impl Pose {
         }
     }
 
+    /// `self ∘ d`: the relative motion `d` (slider frame) applied at `self`, given
+    /// `(sin θ, cos θ)` of `self`. Equals `self.integrate(ξ)` when `d = identity.integrate(ξ)`.
+    pub fn compose(&self, d: &Pose, (s, c): (f64, f64)) -> Pose {
+        Pose::new(
+            self.x + c * d.x - s * d.y,
+            self.y + s * d.x + c * d.y,
+            self.theta + d.theta,
+        )
+    }
+
     /// The slider-frame twist `ξ` with `self.integrate(ξ) == other` and `|ω| ≤ π`: the single
     /// constant push between the two poses.
     pub fn twist_to(&self, other: &Pose) -> V3 {
@@ -147,6 +157,14 @@ pub struct ContactModel {
     pub steps: Vec<V3>,
     /// Step twists near the goal (refined step, §4.5).
     pub fine_steps: Vec<V3>,
+    /// Swept shapes of `body` under `steps`.
+    pub swept: Vec<collision::Swept>,
+    /// Swept shapes of `body` under `fine_steps`.
+    pub fine_swept: Vec<collision::Swept>,
+    /// The relative motion of each step, `exp(step)`.
+    pub deltas: Vec<Pose>,
+    /// The relative motion of each fine step.
+    pub fine_deltas: Vec<Pose>,
 }
 
 /// A stable-pushing planning problem.
@@ -207,11 +225,17 @@ impl Problem {
                 .map(|v| step_twist(&slider, v, params.step))
                 .collect();
             let fine = params.step / params.fine_factor.max(1.0);
-            let fine_steps = usable
+            let fine_steps: Vec<V3> = usable
                 .controls
                 .iter()
                 .map(|v| step_twist(&slider, v, fine))
                 .collect();
+            let steps: Vec<V3> = steps;
+            let swept = steps.iter().map(|xi| body.swept(xi)).collect();
+            let fine_swept = fine_steps.iter().map(|xi| body.swept(xi)).collect();
+            let origin = Pose::new(0.0, 0.0, 0.0);
+            let deltas = steps.iter().map(|xi| origin.integrate(xi)).collect();
+            let fine_deltas = fine_steps.iter().map(|xi| origin.integrate(xi)).collect();
             contacts.push(ContactModel {
                 edge: e,
                 placement,
@@ -220,6 +244,10 @@ impl Problem {
                 footprint,
                 steps,
                 fine_steps,
+                swept,
+                fine_swept,
+                deltas,
+                fine_deltas,
             });
         }
         Ok(Problem {
@@ -237,8 +265,9 @@ impl Problem {
 
     /// Whether `q` is in the refined region around the goal (§4.5).
     pub fn near_goal(&self, q: &Pose) -> bool {
+        let (dx, dy) = (q.x - self.goal.x, q.y - self.goal.y);
         self.params.fine_factor > 1.0
-            && (q.x - self.goal.x).hypot(q.y - self.goal.y) <= self.params.fine_radius
+            && dx * dx + dy * dy <= self.params.fine_radius * self.params.fine_radius
     }
 
     /// The step twists of contact `ci` at configuration `q`.
@@ -248,6 +277,16 @@ impl Problem {
             &cm.fine_steps
         } else {
             &cm.steps
+        }
+    }
+
+    /// The step twists of contact `ci` at `q`, their swept shapes and relative motions.
+    pub fn steps_swept_at(&self, ci: usize, q: &Pose) -> (&[V3], &[collision::Swept], &[Pose]) {
+        let cm = &self.contacts[ci];
+        if self.near_goal(q) {
+            (&cm.fine_steps, &cm.fine_swept, &cm.fine_deltas)
+        } else {
+            (&cm.steps, &cm.swept, &cm.deltas)
         }
     }
 

@@ -292,7 +292,133 @@ pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
             PRESETS.join(", ")
         )
     })?;
+    if is_shared_format(&text) {
+        let shared =
+            pushbot_sim::Scene::from_toml(&text, name_or_path).map_err(|e| anyhow!("{e}"))?;
+        return from_shared(&shared).with_context(|| format!("scene file {name_or_path}"));
+    }
     parse_scene(&text).with_context(|| format!("scene file {name_or_path}"))
+}
+
+/// Whether `text` is in the shared scene format (`[table]` is a table there, an array here).
+fn is_shared_format(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .is_ok_and(|t| t.get("table").is_some_and(|v| v.is_table()))
+}
+
+/// A stable-pushing scene from a scene in the shared format (`pushbot_sim::Scene`) with a
+/// `[stable]` section: the table, the obstacles (as their convex hulls), the pushed object
+/// (its centre of friction from its support distribution, its start from its pose, its goal
+/// from the scene's goal for it, `μ` from its `pusher_friction`), the other objects as static
+/// obstacles, and the pusher and planner settings of `[stable]`; a differential drive takes
+/// its plate from the robot's `front_plate`.
+pub fn from_shared(sc: &pushbot_sim::Scene) -> anyhow::Result<Scene> {
+    use pushbot_sim::scene::Support;
+    use pushbot_sim::scene::stable::StableCost;
+    let st = sc
+        .stable
+        .as_ref()
+        .ok_or_else(|| anyhow!("stable: the scene has no [stable] section"))?;
+    let obj = sc
+        .object(&st.object)
+        .ok_or_else(|| anyhow!("stable.object: no object with id {:?}", st.object))?;
+    let outline = pts(&obj.outline);
+    let cof = match &obj.support {
+        Support::Uniform => centroid(&outline),
+        Support::Points { points, weights } => {
+            let w: Vec<f64> = match weights {
+                Some(w) if w.len() == points.len() => w.clone(),
+                _ => vec![1.0; points.len()],
+            };
+            let total: f64 = w.iter().sum();
+            if points.is_empty() || total.is_nan() || total <= 0.0 {
+                bail!("objects[{}].support: no weight", st.object);
+            }
+            points
+                .iter()
+                .zip(&w)
+                .map(|(p, w)| V2::new(p[0], p[1]) * *w)
+                .sum::<V2>()
+                / total
+        }
+    };
+    // The centre of friction's pose on the table, θ in degrees, from the object frame's pose.
+    let cof_pose = |p: &pushbot_sim::Pose| {
+        let q = Pose::new(p.x, p.y, p.theta).apply(cof);
+        [q.x, q.y, p.theta.to_degrees()]
+    };
+    let goal = sc
+        .goals
+        .iter()
+        .find(|g| g.object == st.object)
+        .ok_or_else(|| anyhow!("goals: no goal for the stable object {:?}", st.object))?;
+    let plate = sc.robot.front_plate;
+    let p = &st.pusher;
+    let diff = p.kind == "diff-drive";
+    let pl = &st.planner;
+    Ok(Scene {
+        name: sc.name.clone(),
+        description: String::new(),
+        table: [sc.table.width, sc.table.height],
+        mu: obj.pusher_friction,
+        obstacles: sc
+            .obstacles
+            .iter()
+            .map(|o| ObstacleSpec {
+                polygon: o.outline.clone(),
+            })
+            .collect(),
+        objects: sc
+            .objects
+            .iter()
+            .map(|o| ObjectSpec {
+                id: o.id.clone(),
+                polygon: o.outline.clone(),
+                centre_of_friction: (o.id == st.object).then_some([cof.x, cof.y]),
+                pose: (o.id != st.object).then_some([
+                    o.pose.x,
+                    o.pose.y,
+                    o.pose.theta.to_degrees(),
+                ]),
+            })
+            .collect(),
+        task: TaskSpec {
+            object: st.object.clone(),
+            start: cof_pose(&obj.pose),
+            goal: cof_pose(&goal.pose),
+            edges: st.edges.clone(),
+            start_edge: st.start_edge,
+            goal_xy_frac: st.goal_xy_frac,
+            goal_theta_deg: st.goal_theta_deg,
+        },
+        pusher: PusherSpec {
+            kind: p.kind.clone(),
+            width: p.width,
+            depth: p.depth,
+            axle_offset: p.axle_offset.or(plate.filter(|_| diff).map(|f| f.offset)),
+            plate_width: p.plate_width.or(plate.filter(|_| diff).map(|f| f.width)),
+            min_turning_radius: p.min_turning_radius,
+        },
+        planner: PlannerSpec {
+            a: pl.a,
+            b: pl.b,
+            c: pl.c.as_ref().map(|c| match c {
+                StableCost::Int(v) => CostSpec::Int(*v),
+                StableCost::Word(w) => CostSpec::Word(w.clone()),
+            }),
+            step_frac: pl.step_frac,
+            grid_xy_frac: pl.grid_xy_frac,
+            grid_theta_deg: pl.grid_theta_deg,
+            max_cost: pl.max_cost,
+            max_nodes: pl.max_nodes,
+            fine_radius_frac: pl.fine_radius_frac,
+            fine_factor: pl.fine_factor,
+        },
+    })
+    .and_then(|s| {
+        validate(&s)?;
+        Ok(s)
+    })
 }
 
 fn finite(v: &[f64]) -> bool {

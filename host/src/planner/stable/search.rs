@@ -11,11 +11,11 @@
 //! §4.5 backs up along the found path to a configuration from which one stable push reaches the
 //! goal exactly.
 
-use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
-use super::collision;
 use super::transit::{TransitPath, transit};
 use super::{Pose, Problem};
 use crate::mechanics::V3;
@@ -47,7 +47,7 @@ impl Hasher for GridHasher {
     }
 }
 
-type GridSet = HashSet<(i64, i64, i64, u32), BuildHasherDefault<GridHasher>>;
+type GridMap = HashMap<(i64, i64, i64, u32), u32, BuildHasherDefault<GridHasher>>;
 
 /// One push step of a plan.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -94,9 +94,9 @@ pub struct Plan {
 /// Which OPEN list to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Queue {
-    /// The paper's array of lists indexed by integer cost.
+    /// The paper's array of first-in first-out lists indexed by integer cost (here `f = g + h`).
     Buckets,
-    /// A binary heap ordered by (cost, insertion order); for cross-checking.
+    /// A binary heap ordered by `(f, insertion order)`; for cross-checking.
     Heap,
 }
 
@@ -111,13 +111,208 @@ struct Node {
     transit: u32,
 }
 
+/// An admissible lower bound on the cost still to pay from a configuration to the goal
+/// neighbourhood: `a` times a lower bound on the number of push steps. It turns the paper's
+/// best-first search (§4.1) into A* without changing what it minimises.
+///
+/// Why it is a lower bound: a step of length `step` moves no slider vertex farther than
+/// `step` along its arc, so the centre of friction (inside the convex hull of the vertices,
+/// hence no farther from the rotation centre than some vertex) moves at most `step`, and the
+/// slider turns at most `step / R` with `R` = half the slider length (every point has a vertex
+/// at least that far away). Steps that start within `fine_radius` of the goal are `fine_factor`
+/// times shorter (§4.5): after the last step that starts outside that disk the centre is still
+/// at least `fine_radius − step` from the goal, and the goal box lies within `goal_xy·√2` of it.
+#[derive(Debug, Clone, Copy)]
+pub struct Heuristic {
+    a: u32,
+    step: f64,
+    fine_step: f64,
+    fine_radius: f64,
+    /// Fine steps needed after the last coarse step.
+    fine_tail: f64,
+    /// Largest rotation of one (coarse) step.
+    turn: f64,
+    goal: Pose,
+    goal_xy: f64,
+    goal_theta: f64,
+}
+
+impl Heuristic {
+    /// The bound for problem `p`.
+    pub fn new(p: &Problem) -> Self {
+        let pa = &p.params;
+        let fine_on = pa.fine_factor > 1.0 && pa.fine_radius > 0.0;
+        let fine_step = if fine_on {
+            pa.step / pa.fine_factor
+        } else {
+            pa.step
+        };
+        let fine_radius = if fine_on { pa.fine_radius } else { 0.0 };
+        let fine_tail = if fine_on {
+            ((fine_radius - pa.step - pa.goal_xy * std::f64::consts::SQRT_2) / fine_step).max(0.0)
+        } else {
+            0.0
+        };
+        let half_len = p.slider.length() / 2.0;
+        Heuristic {
+            a: pa.a,
+            step: pa.step,
+            fine_step,
+            fine_radius,
+            fine_tail,
+            turn: if half_len > 0.0 {
+                pa.step / half_len
+            } else {
+                f64::INFINITY
+            },
+            goal: p.goal,
+            goal_xy: pa.goal_xy,
+            goal_theta: pa.goal_theta,
+        }
+    }
+
+    /// A lower bound on the number of push steps from `q` to the goal neighbourhood.
+    pub fn steps(&self, q: &Pose) -> u32 {
+        let (dx, dy) = ((q.x - self.goal.x).abs(), (q.y - self.goal.y).abs());
+        let (bx, by) = ((dx - self.goal_xy).max(0.0), (dy - self.goal_xy).max(0.0));
+        let d_box = (bx * bx + by * by).sqrt();
+        let d_centre = (dx * dx + dy * dy).sqrt();
+        let n_dist = if self.fine_radius <= 0.0 {
+            d_box / self.step
+        } else if d_centre > self.fine_radius {
+            let tail = self.fine_tail;
+            tail + ((d_box - tail * self.fine_step) / self.step).max(0.0)
+        } else {
+            // Either all remaining steps are fine, or the path leaves the disk and comes back.
+            (d_box / self.fine_step)
+                .min((self.fine_radius - d_centre) / self.fine_step + self.fine_tail)
+        };
+        let turn = (super::angle_diff(q.theta, self.goal.theta).abs() - self.goal_theta).max(0.0);
+        let n_turn = turn / self.turn;
+        // Round down, less a little for rounding errors: a bound, never more.
+        (n_dist.max(n_turn) * (1.0 - 1e-9) - 1e-9).ceil().max(0.0) as u32
+    }
+
+    /// The lower bound on the remaining cost: `a · steps`.
+    pub fn cost(&self, steps: u32) -> u32 {
+        self.a.saturating_mul(steps)
+    }
+}
+
+/// A cell key: `(x, y, θ, contact)` indices, `x` tagged for refined cells.
+type Key = (i64, i64, i64, u32);
+
+/// One dense block of the pruning grid: the least cost each cell was expanded with.
+struct Block {
+    lo: [i64; 3],
+    dim: [i64; 3],
+    contacts: i64,
+    cost: Vec<u32>,
+}
+
+impl Block {
+    /// A block covering cells `lo ..= hi`, or `None` if it would be too large to hold densely.
+    fn new(lo: [i64; 3], hi: [i64; 3], contacts: usize) -> Option<Self> {
+        let dim = [hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1];
+        let n = dim
+            .iter()
+            .try_fold(contacts as i64, |a, &d| a.checked_mul(d.max(0)))?;
+        (n <= 1 << 24).then(|| Block {
+            lo,
+            dim,
+            contacts: contacts as i64,
+            cost: vec![u32::MAX; n as usize],
+        })
+    }
+
+    fn index(&self, k: &Key) -> Option<usize> {
+        let i = [k.0 - self.lo[0], k.1 - self.lo[1], k.2 - self.lo[2]];
+        let inside =
+            (0..3).all(|j| i[j] >= 0 && i[j] < self.dim[j]) && (k.3 as i64) < self.contacts;
+        inside.then(|| {
+            (((k.3 as i64 * self.dim[2] + i[2]) * self.dim[1] + i[1]) * self.dim[0] + i[0]) as usize
+        })
+    }
+}
+
+/// The pruning grid (§4.2.3): for each cell and contact, the least cost it was expanded with
+/// (`u32::MAX`: never). Dense blocks over the table (coarse cells) and around the goal
+/// (refined cells) keep the lookups in cache; cells outside them go to a hash map.
+struct Grid {
+    blocks: Vec<Block>,
+    rest: GridMap,
+}
+
+impl Grid {
+    fn new(p: &Problem) -> Self {
+        let pa = &p.params;
+        let contacts = p.contacts.len();
+        let nt = (2.0 * std::f64::consts::PI / pa.grid_theta).ceil() as i64;
+        let mut blocks = Vec::new();
+        let (w, h) = p.world.table;
+        let coarse = Block::new(
+            [0, 0, 0],
+            [
+                (w / pa.grid_xy).floor() as i64,
+                (h / pa.grid_xy).floor() as i64,
+                nt,
+            ],
+            contacts,
+        );
+        blocks.extend(coarse);
+        if pa.fine_factor > 1.0 && pa.fine_radius > 0.0 {
+            let f = pa.fine_factor / pa.grid_xy;
+            let r = pa.fine_radius;
+            let (gx, gy) = (p.goal.x, p.goal.y);
+            let fine = Block::new(
+                [
+                    ((gx - r) * f).floor() as i64 + (1 << 40),
+                    ((gy - r) * f).floor() as i64,
+                    0,
+                ],
+                [
+                    ((gx + r) * f).floor() as i64 + (1 << 40),
+                    ((gy + r) * f).floor() as i64,
+                    (2.0 * std::f64::consts::PI * pa.fine_factor / pa.grid_theta).ceil() as i64,
+                ],
+                contacts,
+            );
+            blocks.extend(fine);
+        }
+        Grid {
+            blocks,
+            rest: GridMap::default(),
+        }
+    }
+
+    /// The least cost cell `k` was expanded with (`u32::MAX`: never).
+    fn get(&self, k: Key) -> u32 {
+        for b in &self.blocks {
+            if let Some(i) = b.index(&k) {
+                return b.cost[i];
+            }
+        }
+        self.rest.get(&k).copied().unwrap_or(u32::MAX)
+    }
+
+    fn set(&mut self, k: Key, g: u32) {
+        for b in &mut self.blocks {
+            if let Some(i) = b.index(&k) {
+                b.cost[i] = g;
+                return;
+            }
+        }
+        self.rest.insert(k, g);
+    }
+}
+
 /// Plan with the paper's bucketed OPEN list.
 pub fn plan(p: &Problem) -> Plan {
     plan_with(p, Queue::Buckets)
 }
 
 /// The grid cell of a configuration.
-fn cell(p: &Problem, q: &Pose, contact: u32) -> (i64, i64, i64, u32) {
+fn cell(p: &Problem, q: &Pose, contact: u32) -> Key {
     let th = q.theta.rem_euclid(2.0 * std::f64::consts::PI);
     // Refined cells near the goal carry a tag so they never share a key with coarse cells.
     let (f, tag) = if p.near_goal(q) {
@@ -155,9 +350,54 @@ pub fn step_cost(
     Some(c)
 }
 
+/// OPEN: the paper's cost-indexed FIFO lists, or one heap.
+enum Open {
+    Buckets {
+        lists: Vec<VecDeque<u32>>,
+        cur: usize,
+    },
+    Heap(BinaryHeap<Reverse<(u32, u32)>>),
+}
+
+impl Open {
+    fn push(&mut self, f: u32, id: u32) {
+        match self {
+            Open::Buckets { lists, cur } => {
+                let f = f as usize;
+                if f < lists.len() {
+                    lists[f].push_back(id);
+                    *cur = (*cur).min(f);
+                }
+            }
+            Open::Heap(h) => h.push(Reverse((f, id))),
+        }
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        match self {
+            Open::Buckets { lists, cur } => {
+                while *cur < lists.len() {
+                    if let Some(id) = lists[*cur].pop_front() {
+                        return Some(id);
+                    }
+                    *cur += 1;
+                }
+                None
+            }
+            Open::Heap(h) => h.pop().map(|Reverse((_, id))| id),
+        }
+    }
+}
+
 /// Plan with the given OPEN list.
+///
+/// A* on `f = g + h` ([`Heuristic`]). The paper prunes a configuration whose grid cell was
+/// already reached "with the same or lower cost and the same pushing contact" (§4.2.3); the grid
+/// remembers the least cost `g` each cell was expanded with, so a cell reached again more
+/// cheaply (possible once the order is by `f`, not `g`) is expanded again.
 pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     let t0 = Instant::now();
+    let heur = Heuristic::new(p);
     let mut nodes: Vec<Node> = vec![Node {
         q: p.start,
         contact: p.start_contact.map_or(NONE, |c| c as u32),
@@ -169,38 +409,20 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     }];
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
-    let mut occupied: GridSet = GridSet::default();
-    let max_cost = p.params.max_cost as usize;
-    let mut buckets: Vec<std::collections::VecDeque<u32>> = vec![Default::default(); max_cost + 1];
-    let mut heap: BinaryHeap<std::cmp::Reverse<(u32, u32)>> = BinaryHeap::new();
-    let mut cur = 0usize;
-    let push = |buckets: &mut Vec<std::collections::VecDeque<u32>>,
-                heap: &mut BinaryHeap<std::cmp::Reverse<(u32, u32)>>,
-                cost: u32,
-                id: u32| match queue {
-        Queue::Buckets => buckets[cost as usize].push_back(id),
-        Queue::Heap => heap.push(std::cmp::Reverse((cost, id))),
+    let mut occupied = Grid::new(p);
+    let max_cost = p.params.max_cost;
+    let mut open = match queue {
+        Queue::Buckets => Open::Buckets {
+            lists: vec![VecDeque::new(); max_cost as usize + 1],
+            cur: 0,
+        },
+        Queue::Heap => Open::Heap(BinaryHeap::new()),
     };
-    push(&mut buckets, &mut heap, 0, 0);
+    open.push(heur.cost(heur.steps(&p.start)), 0);
     let mut expanded = 0usize;
     let mut goal_node = None;
     // The start must be free for some contact's body; each step checks its own body.
-    loop {
-        let id = match queue {
-            Queue::Buckets => {
-                while cur <= max_cost && buckets[cur].is_empty() {
-                    cur += 1;
-                }
-                if cur > max_cost {
-                    break;
-                }
-                buckets[cur].pop_front().expect("non-empty bucket")
-            }
-            Queue::Heap => match heap.pop() {
-                Some(std::cmp::Reverse((_, id))) => id,
-                None => break,
-            },
-        };
+    while let Some(id) = open.pop() {
         let n = nodes[id as usize].clone();
         if n.needs_transit {
             let key = (n.parent, n.contact);
@@ -227,9 +449,12 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
             goal_node = Some(id);
             break;
         }
-        let key = cell(p, &n.q, n.contact);
-        if n.contact != NONE && !occupied.insert(key) {
-            continue;
+        if n.contact != NONE {
+            let key = cell(p, &n.q, n.contact);
+            if occupied.get(key) <= n.cost {
+                continue;
+            }
+            occupied.set(key, n.cost);
         }
         if expanded >= p.params.max_nodes {
             break;
@@ -243,26 +468,27 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                 n.control as usize
             },
         ));
+        let sc = n.q.theta.sin_cos();
         for (ci, cm) in p.contacts.iter().enumerate() {
-            // One clearance measurement at q serves every step of this contact.
-            let steps = p.steps_at(ci, &n.q);
-            let max_reach = steps.iter().map(|xi| cm.body.reach(xi)).fold(0.0, f64::max);
-            let d0 = cm
-                .body
-                .clearance(&p.world, &n.q, max_reach + collision::CONTACT_EPS);
+            let (steps, swept, deltas) = p.steps_swept_at(ci, &n.q);
             for (k, xi) in steps.iter().enumerate() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
                 };
                 let cost = n.cost.saturating_add(dc);
-                if cost > p.params.max_cost {
+                if cost > max_cost {
                     continue;
                 }
-                let q2 = n.q.integrate(xi);
-                if occupied.contains(&cell(p, &q2, ci as u32)) {
+                let q2 = n.q.compose(&deltas[k], sc);
+                let hs = heur.steps(&q2);
+                let f = cost.saturating_add(heur.cost(hs));
+                if f > max_cost {
                     continue;
                 }
-                if !cm.body.step_free_from(&p.world, &n.q, xi, Some(d0)) {
+                if occupied.get(cell(p, &q2, ci as u32)) <= cost {
+                    continue;
+                }
+                if !cm.body.step_free_swept(&p.world, &n.q, xi, &swept[k]) {
                     continue;
                 }
                 let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
@@ -275,7 +501,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     needs_transit,
                     transit: NONE,
                 });
-                push(&mut buckets, &mut heap, cost, (nodes.len() - 1) as u32);
+                open.push(f, (nodes.len() - 1) as u32);
             }
         }
     }

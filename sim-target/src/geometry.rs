@@ -1,0 +1,338 @@
+//! Shapes, contact points and overlap tests, from `parry2d` (its `f64` build, `parry2d-f64`,
+//! the same version the host uses in `f32`): every body of the world is a set of convex parts
+//! (balls and convex polygons); a non-convex outline is split into convex parts by ear-clipping
+//! triangulation and Hertel–Mehlhorn merging (both parry's), and contact manifolds between
+//! parts come from parry's contact-manifold queries, which give two points for a face-to-face
+//! (line) contact and one otherwise.
+
+use parry2d_f64::math::{Pose as PPose, Vector};
+use parry2d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
+use parry2d_f64::shape::{Ball, ConvexPolygon, HalfSpace, Shape, ShapeType, SharedShape, TriMesh};
+use parry2d_f64::transformation::hertel_mehlhorn;
+
+use crate::robot::Pose;
+
+/// A rigid outline made of convex parts, in its own frame.
+#[derive(Clone)]
+pub struct Outline {
+    parts: Vec<(PPose, SharedShape)>,
+    /// Radius of a circle about the frame's origin that holds the whole outline.
+    radius: f64,
+}
+
+impl std::fmt::Debug for Outline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Outline {{ {} parts, radius {} }}",
+            self.parts.len(),
+            self.radius
+        )
+    }
+}
+
+/// One contact point between two outlines (table frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint {
+    /// Point on the first outline.
+    pub pa: [f64; 2],
+    /// Point on the second outline.
+    pub pb: [f64; 2],
+    /// Unit normal from the first outline towards the second.
+    pub normal: [f64; 2],
+    /// Signed distance along the normal (negative: penetrating).
+    pub dist: f64,
+    /// Which of the first outline's parts touches.
+    pub part_a: usize,
+}
+
+fn v(p: [f64; 2]) -> Vector {
+    Vector::new(p[0], p[1])
+}
+
+fn a(p: Vector) -> [f64; 2] {
+    [p.x, p.y]
+}
+
+fn ppose(p: &Pose) -> PPose {
+    PPose::new(Vector::new(p.x, p.y), p.theta)
+}
+
+/// Why an outline cannot be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ShapeError {
+    /// Fewer than three vertices, or vertices not finite.
+    #[error("a polygon needs at least 3 finite vertices")]
+    TooFew,
+    /// Zero area, or every vertex on one line.
+    #[error("the polygon is degenerate (no area)")]
+    Degenerate,
+    /// Two edges cross.
+    #[error("edges {0} and {1} cross: the polygon is not simple")]
+    SelfIntersecting(usize, usize),
+    /// The triangulation failed.
+    #[error("the polygon could not be split into convex parts")]
+    Decomposition,
+}
+
+/// Signed area (shoelace), positive for counter-clockwise vertices.
+pub fn signed_area(outline: &[[f64; 2]]) -> f64 {
+    let n = outline.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (outline[i], outline[(i + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// Check that a polygon is usable: ≥ 3 finite vertices, an area, no two edges crossing
+/// (parry's segment intersection; adjacent edges may only share their common vertex).
+pub fn check_simple(outline: &[[f64; 2]]) -> Result<(), ShapeError> {
+    use parry2d_f64::utils::segments_intersection2d;
+    let n = outline.len();
+    if n < 3 || outline.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(ShapeError::TooFew);
+    }
+    let scale = outline
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, c| m.max(c.abs()))
+        .max(1e-9);
+    if signed_area(outline).abs() < 1e-12 * scale * scale.max(1.0) || n < 3 {
+        return Err(ShapeError::Degenerate);
+    }
+    for i in 0..n {
+        let (a1, a2) = (v(outline[i]), v(outline[(i + 1) % n]));
+        if (a2 - a1).length() <= 1e-12 * scale {
+            return Err(ShapeError::Degenerate);
+        }
+        for j in i + 1..n {
+            let (b1, b2) = (v(outline[j]), v(outline[(j + 1) % n]));
+            if j == i + 1 || (i == 0 && j == n - 1) {
+                // Adjacent edges share a vertex; they overlap only if they fold back on
+                // themselves (collinear, opposite directions).
+                let (e, f) = if j == i + 1 {
+                    (a2 - a1, b2 - b1)
+                } else {
+                    (b2 - b1, a2 - a1)
+                };
+                if e.perp_dot(f).abs() <= 1e-12 * e.length() * f.length() && e.dot(f) < 0.0 {
+                    return Err(ShapeError::SelfIntersecting(i, j));
+                }
+                continue;
+            }
+            if segments_intersection2d(a1, a2, b1, b2, 1e-12 * scale).is_some() {
+                return Err(ShapeError::SelfIntersecting(i, j));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Corner radius of polygon parts, m: each convex part is its polygon inset by this much with
+/// its border rounded by as much (the same outline, corners rounded by 1 µm). With a border,
+/// parry finds shallow overlaps (up to twice this) from the inner polygons' closest points,
+/// which is robust, rather than from the penetration algorithm (EPA), which can miss contacts
+/// that touch to within its tolerance.
+pub const BORDER: f64 = 1e-6;
+
+/// A convex polygon as an inset polygon with a rounded border of [`BORDER`] (the polygon as is
+/// if it is too thin to inset).
+fn rounded(c: ConvexPolygon) -> SharedShape {
+    let (pts, normals) = (c.points(), c.normals());
+    let n = pts.len();
+    // parry's `ConvexPolygon::offsetted`, inwards: each vertex moves along the bisector.
+    let inset: Vec<Vector> = (0..n)
+        .map(|i2| {
+            let i1 = (i2 + n - 1) % n;
+            let dir = normals[i1] + normals[i2];
+            pts[i2] - (BORDER / dir.dot(normals[i1])) * dir
+        })
+        .collect();
+    // Usable if every inset edge keeps its direction (nothing flipped).
+    let kept = (0..n).all(|i| {
+        let (a, b) = (pts[(i + 1) % n] - pts[i], inset[(i + 1) % n] - inset[i]);
+        a.dot(b) > 0.0 && b.length() > 0.0
+    });
+    if kept && let Some(s) = SharedShape::round_convex_polyline(inset, BORDER) {
+        return s;
+    }
+    SharedShape::new(c)
+}
+
+fn is_convex_ccw(pts: &[Vector]) -> bool {
+    let n = pts.len();
+    (0..n).all(|i| {
+        let (p, q, r) = (pts[i], pts[(i + 1) % n], pts[(i + 2) % n]);
+        (q - p).perp_dot(r - q) >= 0.0
+    })
+}
+
+impl Outline {
+    /// A polygon (either sense, convex or not, but simple), split into convex parts.
+    pub fn polygon(outline: &[[f64; 2]]) -> Result<Outline, ShapeError> {
+        check_simple(outline)?;
+        let mut pts: Vec<Vector> = outline.iter().map(|p| v(*p)).collect();
+        if signed_area(outline) < 0.0 {
+            pts.reverse();
+        }
+        let radius = pts.iter().map(|p| p.length()).fold(0.0, f64::max);
+        let polys = if is_convex_ccw(&pts) {
+            vec![pts]
+        } else {
+            let mesh = TriMesh::from_polygon(pts).ok_or(ShapeError::Decomposition)?;
+            hertel_mehlhorn(mesh.vertices(), mesh.indices())
+        };
+        let parts = polys
+            .into_iter()
+            .map(|p| {
+                ConvexPolygon::from_convex_polyline(p)
+                    .map(|c| (PPose::IDENTITY, rounded(c)))
+                    .ok_or(ShapeError::Decomposition)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if parts.is_empty() {
+            return Err(ShapeError::Decomposition);
+        }
+        Ok(Outline { parts, radius })
+    }
+
+    /// A disc of radius `r` centred on the frame's origin.
+    pub fn disc(r: f64) -> Outline {
+        Outline {
+            parts: vec![(PPose::IDENTITY, SharedShape::new(Ball::new(r)))],
+            radius: r,
+        }
+    }
+
+    /// The half-plane `{p : normal·p ≤ 0}` (a wall; `normal` points out of it).
+    pub fn half_plane(normal: [f64; 2]) -> Outline {
+        let n = v(normal).normalize();
+        Outline {
+            parts: vec![(PPose::IDENTITY, SharedShape::new(HalfSpace::new(n)))],
+            radius: f64::INFINITY,
+        }
+    }
+
+    /// Add a convex part (the vertices must be convex; either sense).
+    pub fn with_convex_part(mut self, outline: &[[f64; 2]]) -> Result<Outline, ShapeError> {
+        let extra = Outline::polygon(outline)?;
+        self.radius = self.radius.max(extra.radius);
+        self.parts.extend(extra.parts);
+        Ok(self)
+    }
+
+    /// Number of convex parts.
+    pub fn parts(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// Radius of a circle about the origin that holds the outline.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Contacts between `self` at `pa` and `other` at `pb`, closer than `prediction` (m).
+    /// Appends to `out`.
+    pub fn contacts(
+        &self,
+        pa: &Pose,
+        other: &Outline,
+        pb: &Pose,
+        prediction: f64,
+        out: &mut Vec<ContactPoint>,
+    ) {
+        let dx = pb.x - pa.x;
+        let dy = pb.y - pa.y;
+        let reach = self.radius + other.radius + prediction;
+        if dx * dx + dy * dy > reach * reach {
+            return;
+        }
+        let (wa, wb) = (ppose(pa), ppose(pb));
+        let dispatcher = DefaultQueryDispatcher;
+        for (ia, (la, sa)) in self.parts.iter().enumerate() {
+            let posa = wa * *la;
+            for (lb, sb) in &other.parts {
+                let posb = wb * *lb;
+                let pos12 = posa.inv_mul(&posb);
+                let mut m: ContactManifold<(), ()> = ContactManifold::new();
+                if dispatcher
+                    .contact_manifold_convex_convex(
+                        &pos12,
+                        &**sa as &dyn Shape,
+                        &**sb as &dyn Shape,
+                        None,
+                        None,
+                        prediction,
+                        &mut m,
+                    )
+                    .is_err()
+                {
+                    continue;
+                }
+                if m.points.is_empty() {
+                    // parry's manifold can come back empty for shapes touching to within
+                    // its GJK tolerance; the single-point contact query still answers
+                    // (half-planes are exact, and not handled by it when second).
+                    let plane = |s: &SharedShape| s.shape_type() == ShapeType::HalfSpace;
+                    if plane(sa) || plane(sb) {
+                        continue;
+                    }
+                    if let Ok(Some(c)) = parry2d_f64::query::contact(
+                        &posa,
+                        &**sa as &dyn Shape,
+                        &posb,
+                        &**sb as &dyn Shape,
+                        prediction,
+                    ) {
+                        out.push(ContactPoint {
+                            pa: a(c.point1),
+                            pb: a(c.point2),
+                            normal: a(c.normal1),
+                            dist: c.dist,
+                            part_a: ia,
+                        });
+                    }
+                    continue;
+                }
+                let n = posa.transform_vector(m.local_n1);
+                for c in &m.points {
+                    if c.dist > prediction {
+                        continue;
+                    }
+                    out.push(ContactPoint {
+                        pa: a(posa.transform_point(c.local_p1)),
+                        pb: a(posb.transform_point(c.local_p2)),
+                        normal: a(n),
+                        dist: c.dist,
+                        part_a: ia,
+                    });
+                }
+            }
+        }
+    }
+
+    /// Whether `self` at `pa` and `other` at `pb` overlap by more than `tolerance` (m).
+    pub fn overlaps(&self, pa: &Pose, other: &Outline, pb: &Pose, tolerance: f64) -> bool {
+        let mut c = Vec::new();
+        self.contacts(pa, other, pb, 0.0, &mut c);
+        c.iter().any(|c| c.dist < -tolerance)
+    }
+
+    /// Penetration depth of `self` at `pa` into `other` at `pb` (0 when apart or touching).
+    pub fn depth(&self, pa: &Pose, other: &Outline, pb: &Pose) -> f64 {
+        let mut c = Vec::new();
+        self.contacts(pa, other, pb, 0.0, &mut c);
+        c.iter().map(|c| -c.dist).fold(0.0, f64::max)
+    }
+
+    /// Whether a table-frame point lies inside the outline placed at `pose`.
+    pub fn contains(&self, pose: &Pose, p: [f64; 2]) -> bool {
+        let w = ppose(pose);
+        self.parts
+            .iter()
+            .any(|(l, s)| s.contains_point(&(w * *l), v(p)))
+    }
+}
