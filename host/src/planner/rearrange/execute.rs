@@ -208,6 +208,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::
         objects,
         goals,
         positions: Vec::new(),
+        camera: Default::default(),
         rearrange: Some(super::scene::rearrange_section(
             problem,
             c,
