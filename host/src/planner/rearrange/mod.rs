@@ -14,9 +14,11 @@
 //!
 //! Limits (§IV-E): the map holds one `u16` per packed configuration, so memory grows as
 //! (free cells)^(1 + r) — 128 MB for the robot and 2 boxes in a 20 × 20 room, 860 MB for 3 boxes in
-//! 12 × 12, and a 4th box or a 3-DOF movable multiplies it again by the cells (and by 4). Time is
-//! bounded by cache misses on that array: the wave front is scattered, so buckets are sorted by
-//! index before they are expanded. Plan costs must stay below 65 535.
+//! 12 × 12, and a 4th box or a 3-DOF movable multiplies it again by the cells (and by 4); the
+//! wave front adds one bit per configuration per bucket (`max_edge + 1` buckets, 24 MB for the
+//! 2-box room). Time is bounded by cache misses on the cost array: the wave front is scattered,
+//! so each bucket is swept in index order (a bit set) and the map is visited in one forward pass
+//! per cost. Plan costs must stay below 65 535.
 
 pub mod admissibility;
 pub mod cases;

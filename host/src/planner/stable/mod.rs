@@ -9,6 +9,7 @@
 //! contacts (§4.6's open problem, [`transit`]), and the exact-goal variant of §4.5.
 
 pub mod collision;
+pub mod execute;
 pub mod presets;
 pub mod pusher;
 pub mod search;
