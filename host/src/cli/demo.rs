@@ -14,7 +14,7 @@
 //! path.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow};
@@ -48,7 +48,7 @@ pub struct DemoArgs {
     )]
     pub stages: Vec<String>,
     /// A stage's scene, `STAGE=PRESET|FILE` (repeatable); defaults: strategy=lau-obstacles,
-    /// rearrange=A1 (two boxes), stable=fig16.
+    /// rearrange=A1 (two boxes), stable=fig15.
     #[arg(long = "scene", value_name = "STAGE=SCENE")]
     pub scenes: Vec<String>,
     /// The robot's serial port: run on a real robot (needs --camera) instead of the built-in
@@ -204,7 +204,9 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
     let rearrange_case = scene_arg(&args, "rearrange", "A1")?.to_string();
     let rearrange_problem = crate::planner::rearrange::cases::load_scene(&rearrange_case)
         .map_err(|e| CliError::bad_input(e.to_string()))?;
-    let stable_name = scene_arg(&args, "stable", "fig16")?.to_string();
+    let stable_name = scene_arg(&args, "stable", "fig15")?.to_string();
+    crate::planner::stable::presets::load_scene(&stable_name)
+        .map_err(|e| CliError::bad_input(format!("{e:#}")))?;
 
     let report = Report::create(&args.out, "pushbot demo", args.png).map_err(CliError::Failed)?;
     let log = std::fs::File::create(args.out.join("demo.log"))
@@ -474,16 +476,76 @@ fn stage_rearrange(
     Ok(st)
 }
 
-/// Lynch & Mason: plan stable pushes, execute open loop.
+/// Lynch & Mason: plan stable pushes for the plated robot, execute them open loop.
 fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
-    let st = StageReport::new(
+    use crate::planner::stable::execute::{execute, robot_problem, robot_start, sim_scene};
+    use crate::planner::stable::{plan, svg};
+
+    let mut st = StageReport::new(
         "stable",
-        &format!("Stable pushing of the slider ({name})"),
-        "Lynch & Mason §3–4",
+        &format!("Stable pushing of the slider among obstacles ({name})"),
+        "Lynch & Mason §3 (STABLE), §4 (planner)",
     );
-    let _ = (ctx, Path::new(name));
-    Err(anyhow!(
-        "the stable-pushing stage is not wired yet ({})",
-        st.title
-    ))
+    let pb = ctx.bar("stable");
+    pb.set_message("planning stable pushes for the plated robot");
+    let (s, p) = robot_problem(name, None)?;
+    let pl = plan(&p);
+    st.number("found", pl.found);
+    st.number("plan_cost", pl.cost);
+    st.number("pushes_planned", pl.pushes);
+    st.number("nodes_expanded", pl.nodes_expanded);
+    st.number("plan_ms", pl.plan_time_ms);
+    let f = ctx
+        .report
+        .figure("stable-plan", &svg::render(&p, Some(&pl)))?;
+    st.figures
+        .push((f, "The plan over stable pushes (Fig. 13–18 style)".into()));
+    if !pl.found {
+        st.notes
+            .push("no plan of stable pushes exists for this robot".into());
+        return Ok(st);
+    }
+    let start = robot_start(&p, &pl).ok_or_else(|| anyhow!("the plan has no step"))?;
+    let scene = sim_scene(&s, &p, start, 1)?;
+    pb.set_message("pushing open loop through the serial port");
+    let ids = vec!["slider".to_string()];
+    let ((pushes, end), trace) =
+        ctx.with_robot(&scene, Some("slider"), &ids, |io| execute(&p, &pl, io))?;
+    pb.finish_and_clear();
+    let pushed: f64 = pushes.iter().map(|r| r.pushed).sum();
+    let worst = pushes
+        .iter()
+        .map(|r| r.drift / r.pushed.max(0.01))
+        .fold(0.0, f64::max);
+    let worst_angle = pushes.iter().map(|r| r.drift_angle).fold(0.0, f64::max);
+    st.success = p.in_goal(&end);
+    st.robot_s = trace.last().map_or(0.0, |t| t.t - trace[0].t);
+    st.number("pushed_m", pushed);
+    st.number("worst_drift_per_100mm_mm", worst * 100.0);
+    st.number("worst_drift_deg", worst_angle.to_degrees());
+    st.number("end_x", end.x);
+    st.number("end_y", end.y);
+    st.number("end_theta_deg", end.theta.to_degrees());
+    if !st.success {
+        st.notes.push(format!(
+            "the slider ended at ({:.3}, {:.3}, {:.1}°), outside the goal neighbourhood",
+            end.x,
+            end.y,
+            end.theta.to_degrees()
+        ));
+    }
+    let f = ctx.report.figure(
+        "stable-run",
+        &figure::run_svg(
+            &scene,
+            &trace,
+            "stable pushes executed open loop (truth)",
+            true,
+        ),
+    )?;
+    st.figures.push((
+        f,
+        "Open-loop execution: the slider stays on the plate".into(),
+    ));
+    Ok(st)
 }

@@ -58,7 +58,12 @@ pub fn robot_start(p: &Problem, plan: &Plan) -> Option<[f64; 3]> {
 
 /// The simulated scene of the problem: the same table and obstacles, the slider (object frame
 /// at its centre of friction, marker `marker_id` on it), the robot with its plate at `start`.
-pub fn sim_scene(s: &StableScene, p: &Problem, start: [f64; 3], marker_id: u32) -> Result<pushbot_sim::Scene> {
+pub fn sim_scene(
+    s: &StableScene,
+    p: &Problem,
+    start: [f64; 3],
+    marker_id: u32,
+) -> Result<pushbot_sim::Scene> {
     let mut t = format!(
         "name = \"{}\"\n[table]\nwidth = {}\nheight = {}\n[robot]\nstart = {{ x = {}, y = {}, theta = {} }}\nfront_plate = {{ width = {PLATE_WIDTH}, offset = {PLATE_OFFSET} }}\n",
         s.name, s.table[0], s.table[1], start[0], start[1], start[2]
@@ -80,7 +85,8 @@ pub fn sim_scene(s: &StableScene, p: &Problem, start: [f64; 3], marker_id: u32) 
         "[[goals]]\nobject = \"slider\"\npose = {{ x = {}, y = {}, theta = {} }}\ntolerance = {}\n",
         p.goal.x, p.goal.y, p.goal.theta, p.params.goal_xy
     );
-    pushbot_sim::Scene::from_toml(&t, &format!("stable scene {}", s.name)).map_err(|e| anyhow!("{e}"))
+    pushbot_sim::Scene::from_toml(&t, &format!("stable scene {}", s.name))
+        .map_err(|e| anyhow!("{e}"))
 }
 
 /// The plan as arcs of the axle centre: per run of steps with one control, the distance driven
@@ -137,7 +143,10 @@ pub fn execute(p: &Problem, plan: &Plan, io: &mut dyn RobotIo) -> Result<(Vec<Pu
         let sp = io
             .body_pose("slider")
             .ok_or_else(|| anyhow!("the slider is not seen"))?;
-        Ok((Pose::new(rp.x, rp.y, rp.theta), Pose::new(sp.x, sp.y, sp.theta)))
+        Ok((
+            Pose::new(rp.x, rp.y, rp.theta),
+            Pose::new(sp.x, sp.y, sp.theta),
+        ))
     };
     let mut pushes = Vec::new();
     for (d, phi) in arcs(p, plan) {
