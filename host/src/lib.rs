@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod exec;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
