@@ -429,12 +429,12 @@ impl World {
         worst
     }
 
-    /// Gather the contacts closer than `prediction` between the robot at `robot`, the objects
-    /// and the static bodies, as solver rows. Objects whose index is in `only` (all if `None`)
-    /// and the robot take part.
-    fn rows(&mut self, robot: &Pose, prediction: f64, with_robot: bool) -> Vec<Row> {
+    /// Gather the contacts closer than `prediction` as solver rows: the robot at `robot` with
+    /// the walls, obstacles and objects, and, for the objects the robot may move (those it
+    /// touches, and those they touch, and so on), theirs. Objects out of reach of that chain
+    /// cannot move this step and take no part.
+    fn rows(&mut self, robot: &Pose, prediction: f64) -> Vec<Row> {
         let mut rows = Vec::new();
-        let r_robot = self.shape.radius();
         let near = |bb: &[f64; 4], p: &Pose, r: f64| {
             p.x + r + prediction >= bb[0]
                 && p.x - r - prediction <= bb[2]
@@ -442,6 +442,7 @@ impl World {
                 && p.y - r - prediction <= bb[3]
         };
         let push = |rows: &mut Vec<Row>, cs: &mut Vec<ContactPoint>, a, b, mu| {
+            let any = !cs.is_empty();
             for c in cs.drain(..) {
                 rows.push(Row {
                     a,
@@ -453,48 +454,50 @@ impl World {
                     mu,
                 });
             }
+            any
         };
         let mut cs = std::mem::take(&mut self.contacts);
-        if with_robot {
-            for (st, at, bb) in &self.statics {
-                if near(bb, robot, r_robot) {
-                    self.shape.contacts(robot, st, at, prediction, &mut cs);
-                    push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Static, 0.0);
-                }
+        let r_robot = self.shape.radius();
+        for (st, at, bb) in &self.statics {
+            if near(bb, robot, r_robot) {
+                self.shape.contacts(robot, st, at, prediction, &mut cs);
+                push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Static, 0.0);
             }
         }
+        let n = self.objects.len();
+        let mut state = vec![0u8; n]; // 0 out of reach, 1 reached, 2 done
+        let mut queue = Vec::new();
         for (k, ((_, s), (o, _))) in self.objects.iter().zip(&self.object_shapes).enumerate() {
-            if with_robot {
-                self.shape.contacts(robot, o, &s.pose, prediction, &mut cs);
-                push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Object(k), s.mu);
+            self.shape.contacts(robot, o, &s.pose, prediction, &mut cs);
+            if push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Object(k), s.mu) {
+                state[k] = 1;
+                queue.push(k);
             }
+        }
+        while let Some(k) = queue.pop() {
+            if state[k] == 2 {
+                continue;
+            }
+            state[k] = 2;
+            let (s, o) = (&self.objects[k].1, &self.object_shapes[k].0);
             for (st, at, bb) in &self.statics {
                 if near(bb, &s.pose, o.radius()) {
                     o.contacts(&s.pose, st, at, prediction, &mut cs);
-                    push(
-                        &mut rows,
-                        &mut cs,
-                        BodyRef::Object(k),
-                        BodyRef::Static,
-                        WALL_FRICTION,
-                    );
+                    let (a, b) = (BodyRef::Object(k), BodyRef::Static);
+                    push(&mut rows, &mut cs, a, b, WALL_FRICTION);
                 }
             }
-            for (j, ((_, s2), (o2, _))) in self
-                .objects
-                .iter()
-                .zip(&self.object_shapes)
-                .enumerate()
-                .skip(k + 1)
-            {
+            for (j, st) in state.iter_mut().enumerate() {
+                if j == k || *st == 2 {
+                    continue;
+                }
+                let (s2, o2) = (&self.objects[j].1, &self.object_shapes[j].0);
                 o.contacts(&s.pose, o2, &s2.pose, prediction, &mut cs);
-                push(
-                    &mut rows,
-                    &mut cs,
-                    BodyRef::Object(k),
-                    BodyRef::Object(j),
-                    OBJECT_FRICTION,
-                );
+                let (a, b) = (BodyRef::Object(k), BodyRef::Object(j));
+                if push(&mut rows, &mut cs, a, b, OBJECT_FRICTION) && *st == 0 {
+                    *st = 1;
+                    queue.push(j);
+                }
             }
         }
         self.contacts = cs;
@@ -538,7 +541,7 @@ impl World {
         let reach = (dx * dx + dy * dy).sqrt() + dth.abs() * self.shape.radius();
         let prediction = 2.0 * reach + 1e-4;
         let pose = self.pose;
-        let rows = self.rows(&pose, prediction, true);
+        let rows = self.rows(&pose, prediction);
         if rows.is_empty() {
             self.pressed = 0;
             return (dx, dy, dth, false);
@@ -559,7 +562,7 @@ impl World {
         let (mut ax, mut ay, mut dth2) = (ax, ay, dth2);
         let mut after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
         for _ in 0..4 {
-            let mut fix = self.rows(&after, 0.0, true);
+            let mut fix = self.rows(&after, 1e-6);
             if fix.iter().all(|r| r.gap >= -1e-12) {
                 break;
             }
