@@ -195,6 +195,11 @@ pub struct World {
     object_shapes: Vec<(Outline, f64)>,
     /// Scratch: contacts of the step.
     contacts: Vec<ContactPoint>,
+    /// The last step's rows (bodies of each) and solution, to warm-start the next solve.
+    last: (
+        Vec<(BodyRef, BodyRef)>,
+        Option<crate::quasistatic::Solution>,
+    ),
 }
 
 impl World {
@@ -268,6 +273,7 @@ impl World {
             statics: Vec::new(),
             object_shapes: Vec::new(),
             contacts: Vec::new(),
+            last: (Vec::new(), None),
         }
         .with_walls()
     }
@@ -552,7 +558,17 @@ impl World {
             d: [dx, dy],
             dth,
         };
-        let sol = solve(&mobiles, &rows, &drive);
+        let same = self.last.0.len() == rows.len()
+            && self.last.0.iter().zip(&rows).all(|(p, r)| *p == (r.a, r.b));
+        let sol = solve(
+            &mobiles,
+            &rows,
+            &drive,
+            self.last.1.as_ref().filter(|_| same),
+        );
+        self.last.0.clear();
+        self.last.0.extend(rows.iter().map(|r| (r.a, r.b)));
+        self.last.1 = Some(sol.clone());
         self.move_objects(&sol.moves);
         let k = sol.scale;
         let (ax, ay, dth2) = (k * dx, k * dy, k * dth);
@@ -581,7 +597,7 @@ impl World {
                     }
                 }
             }
-            let s = crate::quasistatic::solve(&m, &fix, &Drive::default());
+            let s = crate::quasistatic::solve(&m, &fix, &Drive::default(), None);
             self.move_objects(&s.moves[..robot]);
             let [rx, ry, rth] = s.moves[robot];
             ax += rx;
