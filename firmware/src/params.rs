@@ -69,6 +69,10 @@ pub struct RobotParams {
     pub max_distance: f32,
     /// Largest |angle| of a `Spin`, rad.
     pub max_angle: f32,
+    /// `CONTROL_OVERRUN` latches when more than this many control periods pass between two
+    /// steps while the motors are driven (default 3). A real board keeps its deadlines; an
+    /// emulated one on a shared host cannot, and raises this.
+    pub overrun_periods: u32,
 }
 
 impl Default for RobotParams {
@@ -123,6 +127,7 @@ impl Default for RobotParams {
             settle_ms: 200,
             max_distance: 10.0,
             max_angle: 4.0 * core::f32::consts::PI,
+            overrun_periods: 3,
         }
     }
 }

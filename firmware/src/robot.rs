@@ -188,7 +188,7 @@ impl Core {
         self.last_step_us = Some(self.last_step_us.map_or(now_us, |t| t.max(now_us)));
         let dt = dt_us as f32 * 1e-6;
 
-        if !first && self.driving() && overrun(dt_us, period) {
+        if !first && self.driving() && overrun(dt_us, period, self.params.overrun_periods) {
             warn!("control overrun: {} us between steps", dt_us);
             self.overrun_us = Some(now_us);
             self.latch(now_us, Faults::CONTROL_OVERRUN);

@@ -82,9 +82,10 @@ pub fn encoder_jump(delta: i32, max_counts: i64) -> bool {
     i64::from(delta).abs() > max_counts
 }
 
-/// Whether the gap between two control steps (µs) overran the period: more than 3 periods.
-pub fn overrun(dt_us: u64, period_us: u32) -> bool {
-    dt_us > 3 * u64::from(period_us)
+/// Whether the gap between two control steps (µs) overran the period: more than `periods`
+/// periods.
+pub fn overrun(dt_us: u64, period_us: u32, periods: u32) -> bool {
+    dt_us > u64::from(periods.max(1)) * u64::from(period_us)
 }
 
 #[cfg(test)]
@@ -133,7 +134,9 @@ mod tests {
 
     #[test]
     fn overrun_after_three_periods() {
-        assert!(!overrun(3000, 1000));
-        assert!(overrun(3001, 1000));
+        assert!(!overrun(3000, 1000, 3));
+        assert!(overrun(3001, 1000, 3));
+        assert!(!overrun(250_000, 1000, 250));
+        assert!(overrun(250_001, 1000, 250));
     }
 }

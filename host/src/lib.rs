@@ -5,8 +5,11 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod exec;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
+pub mod plot;
+pub mod report;
 pub mod strategy;
 pub mod vision;

@@ -1,8 +1,8 @@
 //! `pushbot-sim`: the simulated robot on a pseudo-terminal.
 //!
-//! Prints one JSON line first — `{"serial": "/dev/pts/N", "seed": …, "speed": …, "table": [w, h],
-//! …}` — then runs until its standard input closes (or it is killed). A host opens the `serial`
-//! path as it would a real robot's port.
+//! Prints one JSON line first — `{"serial": "/dev/pts/N", …, "camera": "127.0.0.1:PORT", …}` —
+//! then runs until its standard input closes (or it is killed). A host opens the `serial` path
+//! as it would a real robot's port, and the `camera` socket as its overhead camera.
 #![forbid(unsafe_code)]
 
 use std::io::{Read, Write};
@@ -70,6 +70,17 @@ struct Cli {
     /// Run until killed instead of until standard input closes.
     #[arg(long)]
     no_stdin: bool,
+    /// Serve the overhead camera on this address (`HOST:PORT`; port 0 picks a free one). Its
+    /// address is the first line's `camera`: a host opens `--camera sim:HOST:PORT`.
+    #[arg(long, value_name = "HOST:PORT", default_value = "127.0.0.1:0")]
+    camera: String,
+    /// Do not run the camera.
+    #[arg(long, conflicts_with = "frames")]
+    no_camera: bool,
+    /// Also write every camera frame to DIR as `frame-NNNNNN.png` with its ground truth
+    /// `frame-NNNNNN.json` (markers' table poses and pixel corners).
+    #[arg(long, value_name = "DIR")]
+    frames: Option<PathBuf>,
 }
 
 /// The first line on stdout, in this key order.
@@ -92,6 +103,8 @@ struct FirstLine<'a> {
     objects: Vec<&'a str>,
     /// Whether link faults are injected.
     faults: bool,
+    /// The camera's socket (`HOST:PORT`), absent with --no-camera.
+    camera: Option<String>,
     pid: u32,
 }
 
@@ -204,6 +217,10 @@ fn run(cli: Cli) -> Result<()> {
         truth_hz: cli.truth_hz,
         start,
         table: (width, height),
+        camera: (!cli.no_camera).then(|| pushbot_sim::camera::live::LiveCameraOptions {
+            addr: cli.camera.clone(),
+            frames_dir: cli.frames.clone(),
+        }),
         ..SimOptions::default()
     };
     let sim = PtySim::start(opts.clone())?;
@@ -221,6 +238,7 @@ fn run(cli: Cli) -> Result<()> {
             .map(|s| s.objects.iter().map(|o| o.id.as_str()).collect())
             .unwrap_or_default(),
         faults: opts.faults.is_some(),
+        camera: sim.camera_addr().map(|a| a.to_string()),
         pid: std::process::id(),
     };
     {

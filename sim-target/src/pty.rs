@@ -137,6 +137,7 @@ pub struct PtySim {
     objects: Arc<Mutex<Vec<(String, crate::Pose)>>>,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<Result<()>>>,
+    camera: Option<crate::camera::live::LiveCamera>,
 }
 
 impl PtySim {
@@ -162,6 +163,18 @@ impl PtySim {
         let truth = Arc::new(Mutex::new(sim.truth()));
         let objects = Arc::new(Mutex::new(sim.object_poses()));
         let stop = Arc::new(AtomicBool::new(false));
+        let camera = match &opts.camera {
+            Some(c) => Some(crate::camera::live::LiveCamera::start(
+                opts.effective_scene(),
+                opts.seed,
+                c,
+                crate::camera::live::WorldView {
+                    truth: Arc::clone(&truth),
+                    objects: Arc::clone(&objects),
+                },
+            )?),
+            None => None,
+        };
         let runner = Runner {
             sim,
             pty,
@@ -183,7 +196,14 @@ impl PtySim {
             objects,
             stop,
             thread: Some(thread),
+            camera,
         })
+    }
+
+    /// The camera socket's address (`HOST:PORT`), when the camera runs: a host opens
+    /// `sim:HOST:PORT` as its camera.
+    pub fn camera_addr(&self) -> Option<std::net::SocketAddr> {
+        self.camera.as_ref().map(|c| c.addr())
     }
 
     /// Path of the robot's serial port: open it with `serialport` as a real robot's.
@@ -219,14 +239,16 @@ impl PtySim {
     }
 
     fn stop_and_join(&mut self) -> Result<()> {
+        let camera = self.camera.take().map_or(Ok(()), |c| c.shutdown());
         self.stop.store(true, Ordering::Relaxed);
-        match self.thread.take() {
+        let robot = match self.thread.take() {
             Some(t) => match t.join() {
                 Ok(r) => r,
                 Err(_) => Err(anyhow::anyhow!("the simulation thread panicked")),
             },
             None => Ok(()),
-        }
+        };
+        robot.and(camera)
     }
 }
 

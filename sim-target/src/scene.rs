@@ -48,6 +48,9 @@ use serde::{Deserialize, Serialize};
 use crate::robot::Pose;
 
 mod checks;
+pub mod camera;
+pub use camera::CameraSpec;
+pub mod rearrange;
 
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -73,6 +76,12 @@ pub struct Scene {
     /// Named poses (start positions of a layout, waypoints).
     #[serde(default)]
     pub positions: Vec<NamedPose>,
+    /// The overhead camera: image, robot marker, calibration markers.
+    #[serde(default)]
+    pub camera: CameraSpec,
+    /// Grid rearrangement planning settings (see [`rearrange`]); the simulator ignores them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rearrange: Option<rearrange::Rearrange>,
 }
 
 /// The table: a rectangle with its origin at the lower-left corner; its edges are walls.
@@ -417,6 +426,12 @@ impl Scene {
         self.objects.iter().find(|o| o.id == id)
     }
 
+    /// The calibration markers fixed on the table (table frame).
+    pub fn fiducials(&self) -> Vec<Marker> {
+        self.camera
+            .fiducials_on(self.table.width, self.table.height)
+    }
+
     /// The named pose with this name.
     pub fn position(&self, name: &str) -> Option<Pose> {
         self.positions
@@ -558,6 +573,7 @@ impl Scene {
                 return Err(invalid(at("angle_tolerance"), "must be positive"));
             }
         }
+        self.check_markers()?;
         for (i, p) in self.positions.iter().enumerate() {
             if !pose_finite(&p.pose) {
                 return Err(invalid(
@@ -567,6 +583,80 @@ impl Scene {
             }
         }
         self.check_geometry()
+    }
+}
+
+impl Scene {
+    /// Every marker is drawable, calibration markers lie on the table, and no tag id is used
+    /// twice (the camera could not tell the bodies apart).
+    fn check_markers(&self) -> Result<(), Invalid> {
+        use Seg::{Index, Key};
+        let c = &self.camera;
+        if c.width < 64 || c.height < 64 || c.width > 8192 || c.height > 8192 {
+            return Err(invalid(
+                vec![Key("camera"), Key("width")],
+                "the image must be 64..=8192 pixels on each side",
+            ));
+        }
+        if !(c.fps.is_finite() && c.fps > 0.0 && c.fps <= 1000.0) {
+            return Err(invalid(
+                vec![Key("camera"), Key("fps")],
+                "must be a frame rate in (0, 1000]",
+            ));
+        }
+        let drawable =
+            |m: &Marker| m.x.is_finite() && m.y.is_finite() && m.size.is_finite() && m.size > 0.0;
+        let mut used: Vec<(u32, Vec<Seg>)> = Vec::new();
+        let mut add = |id: u32, path: Vec<Seg>| -> Result<(), Invalid> {
+            if id >= 587 {
+                return Err(invalid(
+                    path,
+                    format!("tag id {id} is not in tag36h11 (0..=586)"),
+                ));
+            }
+            if let Some((_, first)) = used.iter().find(|(u, _)| *u == id) {
+                return Err(invalid(
+                    path,
+                    format!("tag id {id} is already used by {}", path_string(first)),
+                ));
+            }
+            used.push((id, path));
+            Ok(())
+        };
+        let rm = vec![Key("camera"), Key("robot_marker")];
+        if !drawable(&c.robot_marker) {
+            return Err(invalid(rm, "needs a finite centre and a positive size"));
+        }
+        add(c.robot_marker.id, rm)?;
+        for (i, o) in self.objects.iter().enumerate() {
+            if let Some(m) = &o.marker {
+                add(m.id, vec![Key("objects"), Index(i), Key("marker")])?;
+            }
+        }
+        for (i, g) in self.goals.iter().enumerate() {
+            if let Some(m) = &g.marker {
+                let at = vec![Key("goals"), Index(i), Key("marker")];
+                if !drawable(m) {
+                    return Err(invalid(at, "needs a finite centre and a positive size"));
+                }
+                add(m.id, at)?;
+            }
+        }
+        let (w, h) = (self.table.width, self.table.height);
+        for (i, m) in self.fiducials().iter().enumerate() {
+            let at = vec![Key("camera"), Key("fiducials"), Index(i)];
+            let half = m.size / 2.0;
+            if !(drawable(m)
+                && m.x - half >= 0.0
+                && m.x + half <= w
+                && m.y - half >= 0.0
+                && m.y + half <= h)
+            {
+                return Err(invalid(at, "a calibration marker must lie on the table"));
+            }
+            add(m.id, at)?;
+        }
+        Ok(())
     }
 }
 

@@ -50,6 +50,8 @@ pub struct SimOptions {
     pub scene: Option<Scene>,
     /// Link faults injected between the pty and the firmware ([`crate::PtySim`] only).
     pub faults: Option<LinkFaults>,
+    /// Run the overhead camera beside the served robot ([`crate::PtySim`] only).
+    pub camera: Option<crate::camera::live::LiveCameraOptions>,
 }
 
 impl Default for SimOptions {
@@ -67,6 +69,34 @@ impl Default for SimOptions {
             substeps: 1,
             scene: None,
             faults: None,
+            camera: None,
+        }
+    }
+}
+
+impl SimOptions {
+    /// The scene these options describe: `scene` itself, or an empty table of `table` with the
+    /// reference robot at `start`.
+    pub fn effective_scene(&self) -> Scene {
+        match &self.scene {
+            Some(s) => s.clone(),
+            None => Scene {
+                name: "table".into(),
+                table: crate::scene::Table {
+                    width: self.table.0,
+                    height: self.table.1,
+                },
+                robot: crate::scene::RobotSpec {
+                    start: self.start,
+                    ..crate::scene::RobotSpec::default()
+                },
+                obstacles: Vec::new(),
+                objects: Vec::new(),
+                goals: Vec::new(),
+                positions: Vec::new(),
+                camera: crate::scene::CameraSpec::default(),
+                rearrange: None,
+            },
         }
     }
 }

@@ -154,12 +154,15 @@ async fn main(spawner: Spawner) {
     watchdog.start(WATCHDOG_TIMEOUT);
     defmt::info!("watchdog: {} ms", WATCHDOG_TIMEOUT.as_millis());
 
-    shell::control_loop(Pico {
-        drive,
-        left,
-        right,
-        watchdog,
-    })
+    shell::control_loop(
+        Pico {
+            drive,
+            left,
+            right,
+            watchdog,
+        },
+        pushbot_firmware::RobotParams::default(),
+    )
     .await
 }
 

@@ -79,10 +79,10 @@ pub fn sanitize_duty(d: f32) -> f32 {
     }
 }
 
-/// Run the robot: the control loop at the core's rate, forever.
-pub async fn control_loop<H: Hardware>(mut hw: H) -> ! {
+/// Run the robot built as `params` says: the control loop at the core's rate, forever.
+pub async fn control_loop<H: Hardware>(mut hw: H, params: RobotParams) -> ! {
     hw.motors_off();
-    let mut core = Core::new(RobotParams::default());
+    let mut core = Core::new(params);
     let period_us = u64::from(core.tick_period_us().max(1));
     defmt::info!("control loop: period {} us", period_us);
     let mut ticker = Ticker::every(Duration::from_micros(period_us));

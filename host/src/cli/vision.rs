@@ -20,8 +20,12 @@ pub struct CameraArgs {
     /// Frame source: /dev/videoN (V4L2), sim:HOST:PORT (the sim camera), or a folder of images.
     #[arg(long)]
     pub camera: String,
-    /// Marker layout (TOML or JSON: table, calibration markers, body markers); default: the
-    /// built-in 1.2 × 0.9 m table.
+    /// The scene on the table (preset name or TOML file): its calibration markers and the
+    /// markers on the robot, the objects and the goals.
+    #[arg(long, value_name = "PRESET|FILE", conflicts_with = "layout")]
+    pub scene: Option<String>,
+    /// A stand-alone marker layout instead of a scene (TOML or JSON: table, calibration
+    /// markers, body markers); default: the built-in 1.2 × 0.9 m table.
     #[arg(long)]
     pub layout: Option<PathBuf>,
     /// Frame rate assumed for image folders without time sidecars.
@@ -74,6 +78,11 @@ pub enum BenchCommand {
 }
 
 fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
+    if let Some(scene) = &args.scene {
+        let scene = pushbot_sim::Scene::preset_or_file(scene)
+            .map_err(|e| CliError::bad_input(e.to_string()))?;
+        return Ok(MarkerLayout::from_scene(&scene));
+    }
     match &args.layout {
         Some(p) => MarkerLayout::load(p).map_err(CliError::bad_input),
         None => Ok(MarkerLayout::default_table()),

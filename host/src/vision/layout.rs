@@ -1,7 +1,8 @@
-//! The minimal scene description vision needs until the shared scene format carries it: the
-//! table's size, the calibration markers fixed at known table positions, and which marker sits
-//! where on which body (robot, objects, goals), as in Lau et al. §IV (markers on the robot, the
-//! object and the goal).
+//! What vision needs to know of a scene: the table's size, the calibration markers fixed at
+//! known table positions, and which marker sits where on which body (robot, objects, goals), as
+//! in Lau et al. §IV (markers on the robot, the object and the goal). Normally taken from the
+//! shared scene format ([`MarkerLayout::from_scene`]); a stand-alone TOML/JSON layout file is
+//! still accepted for cameras over tables that have no scene.
 
 use std::path::Path;
 
@@ -176,6 +177,45 @@ impl MarkerLayout {
                 body("object2", 12, [-0.03, 0.02, std::f64::consts::FRAC_PI_2]),
                 body("goal", 20, [0.0, 0.0, 0.0]),
             ],
+        }
+    }
+
+    /// The layout a scene describes: its table, its calibration markers (`[camera] fiducials`),
+    /// the robot's marker (body `robot`), each object's marker (body = the object's id) and each
+    /// goal's marker (body `goal:<object id>`).
+    pub fn from_scene(scene: &pushbot_sim::Scene) -> MarkerLayout {
+        let body = |name: String, m: &pushbot_sim::scene::Marker| BodyMarker {
+            body: name,
+            id: m.id,
+            family: MarkerFamily::Tag36h11,
+            side: m.size,
+            offset: [m.x, m.y, 0.0],
+        };
+        let mut bodies = vec![body("robot".into(), &scene.camera.robot_marker)];
+        for o in &scene.objects {
+            if let Some(m) = &o.marker {
+                bodies.push(body(o.id.clone(), m));
+            }
+        }
+        for g in &scene.goals {
+            if let Some(m) = &g.marker {
+                bodies.push(body(format!("goal:{}", g.object), m));
+            }
+        }
+        MarkerLayout {
+            table: [scene.table.width, scene.table.height],
+            calibration: scene
+                .fiducials()
+                .iter()
+                .map(|m| FixedMarker {
+                    id: m.id,
+                    family: MarkerFamily::Tag36h11,
+                    centre: [m.x, m.y],
+                    heading: 0.0,
+                    side: m.size,
+                })
+                .collect(),
+            bodies,
         }
     }
 

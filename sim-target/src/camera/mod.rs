@@ -8,7 +8,9 @@
 //! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
 
 pub mod families;
+pub mod live;
 pub mod render;
+pub mod scene_view;
 pub mod server;
 
 use std::path::{Path, PathBuf};
@@ -18,6 +20,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 pub use render::{Homography, MarkerFamily, MarkerPlacement, Polygon, TagCodes};
+pub use scene_view::{SceneCamera, scene_view};
 
 /// Where the camera looks: image size and the table-plane → pixel homography.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -1,0 +1,400 @@
+//! The robot on the table as the strategy and the planners see it
+//! ([`RobotIo`]), over a real serial link and a real overhead camera.
+//!
+//! Every primitive is a firmware command sent through [`crate::link::Robot`] and waited for to
+//! its `Done`; every pose is what the camera shows *after* the primitive ended: fresh frames
+//! through marker detection, the calibration homography and the Kalman tracker
+//! ([`crate::vision::Pipeline`]). The host acts in steps (observe → decide → primitive → observe,
+//! DESIGN.md "Time"), so it never waits on the wall clock for the robot to move, and the same
+//! code runs against the simulated target at any speed.
+
+use std::collections::HashMap;
+use std::time::Duration;
+
+use anyhow::{Context, Result, anyhow, bail};
+use nalgebra::Vector2;
+use pushbot_protocol::Outcome;
+use pushbot_sim::Scene;
+
+use super::grabber::FrameGrabber;
+use crate::link::{LinkOptions, Robot};
+use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
+use crate::strategy::sample::Pose2;
+use crate::vision::Pipeline;
+use crate::vision::calibration::Calibration;
+use crate::vision::detect::{DetectorKind, make_detector};
+use crate::vision::layout::MarkerLayout;
+use crate::vision::tracking::TrackerParams;
+
+/// Settings of a [`LiveRobot`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiveOptions {
+    /// Drive speed, m/s.
+    pub speed: f64,
+    /// Spin rate, rad/s.
+    pub spin_rate: f64,
+    /// How far inside the table the object's boundary lies, m (Lau et al. §III-A).
+    pub boundary_inset: f64,
+    /// The object [`RobotIo::object_pose`] reports (default: the scene's first object with a
+    /// marker).
+    pub object: Option<String>,
+    /// Marker detector.
+    pub detector: DetectorKind,
+    /// A saved calibration; without one, the first frames calibrate the camera from the
+    /// scene's calibration markers.
+    pub calibration: Option<Calibration>,
+    /// Frames processed per look after a primitive.
+    pub frames_per_look: usize,
+    /// Longest wait for a frame, wall time.
+    pub frame_timeout: Duration,
+    /// Frame rate assumed for image folders.
+    pub fps: f64,
+    /// The robot's link watchdog, ms of robot time: the robot stops this long after the host
+    /// goes quiet. Longer than the firmware's 200 ms default so a host busy with vision does
+    /// not stop the robot mid-push; against a simulated target running N times faster than
+    /// real time, multiply it by N (the host's threads get N times less wall time per robot
+    /// second).
+    pub watchdog_ms: u16,
+    /// Keep a live view (camera image, detections, tracked poses) in this folder
+    /// ([`super::view`]).
+    pub view_dir: Option<std::path::PathBuf>,
+    /// The serial link's settings.
+    pub link: LinkOptions,
+}
+
+impl Default for LiveOptions {
+    fn default() -> Self {
+        LiveOptions {
+            speed: 0.12,
+            spin_rate: 3.0,
+            boundary_inset: 0.2,
+            object: None,
+            detector: DetectorKind::ApriltagC,
+            calibration: None,
+            frames_per_look: 1,
+            frame_timeout: Duration::from_secs(10),
+            fps: 30.0,
+            watchdog_ms: 1000,
+            view_dir: None,
+            link: LinkOptions::default(),
+        }
+    }
+}
+
+/// A robot on a serial port, seen by a camera.
+pub struct LiveRobot {
+    robot: Robot,
+    grabber: FrameGrabber,
+    pipeline: Pipeline,
+    opts: LiveOptions,
+    /// The object [`RobotIo::object_pose`] reports, if the scene has one.
+    object: Option<String>,
+    marker: [f64; 2],
+    workspace: Workspace,
+    /// Latest pose of each body (`robot`, object ids, `goal:<id>`) and the frame time it is for.
+    poses: HashMap<String, (Pose2, f64)>,
+    /// Whether `poses` were looked at since the last primitive.
+    fresh: bool,
+    /// Why the camera stopped, once it has: the next primitive fails with it.
+    camera_error: Option<String>,
+    t0_us: u64,
+    frames_seen: u64,
+    view: Option<super::view::LiveView>,
+}
+
+impl std::fmt::Debug for LiveRobot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LiveRobot")
+            .field("port", &self.robot.path())
+            .field("camera", &self.grabber.describe())
+            .field("object", &self.object)
+            .finish()
+    }
+}
+
+impl LiveRobot {
+    /// Connect to the robot on `port` and the camera `camera` (as `--camera` spells it) over
+    /// the table of `scene`; calibrate unless `opts` brings a calibration; look once.
+    pub fn connect(port: &str, camera: &str, scene: &Scene, opts: LiveOptions) -> Result<Self> {
+        let object = match &opts.object {
+            Some(id) => Some(
+                scene
+                    .object(id)
+                    .ok_or_else(|| anyhow!("scene {} has no object {id:?}", scene.name))?,
+            ),
+            None => scene
+                .objects
+                .iter()
+                .find(|o| o.marker.is_some())
+                .or(scene.objects.first()),
+        };
+        let marker = object
+            .and_then(|o| o.marker)
+            .map_or([0.0, 0.0], |m| [m.x, m.y]);
+        let object_radius = object.map_or(0.0, |o| {
+            o.outline
+                .iter()
+                .map(|v| (v[0] - marker[0]).hypot(v[1] - marker[1]))
+                .fold(0.0, f64::max)
+        });
+        let table = Rect {
+            min: [0.0, 0.0],
+            max: [scene.table.width, scene.table.height],
+        };
+        let workspace = Workspace {
+            table,
+            boundary: table.inset(opts.boundary_inset),
+            robot_radius: scene.robot.bumper_radius,
+            object_radius,
+        };
+        let robot = Robot::connect(port, opts.link.clone())
+            .with_context(|| format!("connecting to the robot on {port}"))?;
+        robot
+            .configure(pushbot_protocol::ConfigUpdate {
+                watchdog_ms: Some(opts.watchdog_ms),
+                ..Default::default()
+            })
+            .context("configuring the robot's link watchdog")?;
+        let t0_us = robot.telemetry().map_or(0, |t| t.time_us);
+        let grabber = FrameGrabber::open(camera, opts.fps)
+            .with_context(|| format!("opening the camera {camera}"))?;
+        let layout = MarkerLayout::from_scene(scene);
+        let families = layout.families();
+        let calibration = match &opts.calibration {
+            Some(c) => c.clone(),
+            None => calibrate(&grabber, &layout, opts.detector, opts.frame_timeout)?,
+        };
+        let detector = make_detector(opts.detector, &families)?;
+        let params = TrackerParams {
+            // The host looks only between primitives: a body that moved since the last look
+            // is a jump, not an outlier — restart its filter at once.
+            restart_after: 1,
+            ..TrackerParams::default()
+        };
+        let pipeline = Pipeline::new(detector, layout, calibration, params);
+        let view = match &opts.view_dir {
+            Some(d) => Some(super::view::LiveView::create(d)?),
+            None => None,
+        };
+        let mut live = LiveRobot {
+            robot,
+            grabber,
+            pipeline,
+            object: object.map(|o| o.id.clone()),
+            marker,
+            workspace,
+            poses: HashMap::new(),
+            fresh: false,
+            camera_error: None,
+            t0_us,
+            frames_seen: 0,
+            view,
+            opts,
+        };
+        live.look()?;
+        if !live.poses.contains_key("robot") {
+            bail!(
+                "the camera does not see the robot's marker (tag {})",
+                scene.camera.robot_marker.id
+            );
+        }
+        Ok(live)
+    }
+
+    /// The link to the robot.
+    pub fn link(&self) -> &Robot {
+        &self.robot
+    }
+
+    /// The calibration in use.
+    pub fn calibration(&self) -> &Calibration {
+        self.pipeline.calibration()
+    }
+
+    /// The live view, if one is kept: set its `plan` to draw a path.
+    pub fn view_mut(&mut self) -> Option<&mut super::view::LiveView> {
+        self.view.as_mut()
+    }
+
+    /// Frames processed so far.
+    pub fn frames_seen(&self) -> u64 {
+        self.frames_seen
+    }
+
+    /// The latest pose of a tracked body (`robot`, an object id or `goal:<object id>`), with
+    /// the time of the frame it is from; looks first if a primitive ran since the last look.
+    pub fn tracked(&mut self, body: &str) -> Option<(Pose2, f64)> {
+        self.look_if_stale();
+        self.poses.get(body).copied()
+    }
+
+    /// Look now: process fresh frames (taken after this call) and update every body's pose.
+    pub fn look(&mut self) -> Result<()> {
+        // The frame being rendered or exposed right now may show the past: skip it.
+        let mut after = self.grabber.count() + 1;
+        for _ in 0..self.opts.frames_per_look.max(1) {
+            let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
+            after = n;
+            let r = self.pipeline.process(&frame)?;
+            self.frames_seen += 1;
+            if let Some(v) = self.view.as_mut()
+                && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
+            {
+                tracing::warn!("live view: {e:#}");
+            }
+            for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
+                let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
+                self.poses.insert(t.body.clone(), (p, t.time));
+            }
+        }
+        self.fresh = true;
+        Ok(())
+    }
+
+    fn look_if_stale(&mut self) {
+        if self.fresh || self.camera_error.is_some() {
+            return;
+        }
+        if let Err(e) = self.look() {
+            tracing::warn!("camera: {e:#}");
+            self.camera_error = Some(format!("{e:#}"));
+        }
+    }
+
+    fn pose_of(&mut self, body: &str) -> Pose2 {
+        self.look_if_stale();
+        self.poses
+            .get(body)
+            .map_or(Pose2::new(f64::NAN, f64::NAN, f64::NAN), |(p, _)| *p)
+    }
+
+    /// Run one motion to its end; a fault it ended in (a stall against something that does not
+    /// move) is cleared and the motion counts as ended, as the strategy expects.
+    fn motion(&mut self, what: &str, run: impl Fn(&Robot) -> Result<Outcome>) -> Result<()> {
+        if let Some(e) = &self.camera_error {
+            bail!("the camera stopped: {e}");
+        }
+        self.fresh = false;
+        for attempt in 0..2 {
+            match run(&self.robot) {
+                Ok(Outcome::Fault(f)) if f.contains(pushbot_protocol::Faults::LINK_LOST) => {
+                    self.clear_faults()?;
+                    bail!(
+                        "{what} on {} was cut short: the robot's link watchdog fired ({}); the \
+                         host was too slow to keep the link alive",
+                        self.robot.path(),
+                        crate::link::FaultNames(f)
+                    );
+                }
+                Ok(Outcome::Fault(f)) => {
+                    tracing::debug!("{what} ended in fault {}", crate::link::FaultNames(f));
+                    self.clear_faults()?;
+                    return Ok(());
+                }
+                Ok(_) => return Ok(()),
+                Err(e) if attempt == 0 && is_faulted_refusal(&e) => self.clear_faults()?,
+                Err(e) => return Err(e.context(format!("{what} on {}", self.robot.path()))),
+            }
+        }
+        bail!("the robot stayed faulted")
+    }
+
+    fn clear_faults(&mut self) -> Result<()> {
+        // A fault clears only once its cause has been quiet for a while (robot time).
+        for _ in 0..50 {
+            if self.robot.clear_faults()?.is_empty() {
+                return Ok(());
+            }
+            let after = self.robot.telemetry().map(|t| t.time_us + 100_000);
+            let _ = self.robot.wait_telemetry(after);
+        }
+        bail!("the robot's faults would not clear")
+    }
+}
+
+fn is_faulted_refusal(e: &anyhow::Error) -> bool {
+    matches!(
+        e.downcast_ref::<crate::link::LinkError>(),
+        Some(crate::link::LinkError::Refused {
+            reason: crate::link::Refusal(pushbot_protocol::NackReason::Faulted(_)),
+            ..
+        })
+    )
+}
+
+/// Fit the camera's calibration from a few frames of the scene's calibration markers.
+fn calibrate(
+    grabber: &FrameGrabber,
+    layout: &MarkerLayout,
+    kind: DetectorKind,
+    timeout: Duration,
+) -> Result<Calibration> {
+    let mut det = make_detector(kind, &layout.families())?;
+    let mut frames = Vec::new();
+    let mut size = [0, 0];
+    let mut after = grabber.count();
+    for _ in 0..3 {
+        let (n, frame) = grabber.next_after(after, timeout)?;
+        after = n;
+        size = [frame.width, frame.height];
+        frames.push(det.detect(&frame)?);
+    }
+    Calibration::fit(&frames, layout, size).context("calibrating the camera")
+}
+
+impl RobotIo for LiveRobot {
+    fn spin(&mut self, angle: f64) -> Result<()> {
+        let angle = crate::strategy::sample::wrap_angle(angle);
+        if !angle.is_finite() || angle.abs() < 1e-3 {
+            return Ok(());
+        }
+        let rate = self.opts.spin_rate as f32;
+        self.motion("spin", |r| Ok(r.spin(angle as f32, rate)?.outcome))
+    }
+
+    fn forward(&mut self, distance: f64) -> Result<()> {
+        if !distance.is_finite() || distance.abs() < 5e-4 {
+            return Ok(());
+        }
+        let speed = self.opts.speed as f32;
+        let d = distance.clamp(-2.0, 2.0) as f32;
+        self.motion("move", |r| Ok(r.move_distance(d, speed, false)?.outcome))
+    }
+
+    fn drive(&mut self, v: f64, omega: f64, duration: f64) -> Result<()> {
+        let ms = (duration * 1e3).clamp(1.0, 60_000.0) as u64;
+        let (v, omega) = (v.clamp(-0.3, 0.3) as f32, omega.clamp(-4.0, 4.0) as f32);
+        self.motion("velocity", |r| {
+            let m = r.velocity(v, omega, Duration::from_millis(ms))?;
+            Ok(r.wait(&m)?.outcome)
+        })
+    }
+
+    fn robot_pose(&mut self) -> Pose2 {
+        self.pose_of("robot")
+    }
+
+    fn object_pose(&mut self) -> Pose2 {
+        let Some(id) = self.object.clone() else {
+            return Pose2::new(f64::NAN, f64::NAN, f64::NAN);
+        };
+        let body = self.pose_of(&id);
+        let m = body.point_to_world(Vector2::new(self.marker[0], self.marker[1]));
+        Pose2::new(m.x, m.y, body.theta)
+    }
+
+    fn body_pose(&mut self, id: &str) -> Option<Pose2> {
+        self.look_if_stale();
+        self.poses.get(id).map(|(p, _)| *p)
+    }
+
+    fn time(&self) -> f64 {
+        self.robot
+            .telemetry()
+            .map_or(0.0, |t| t.time_us.saturating_sub(self.t0_us) as f64 * 1e-6)
+    }
+
+    fn workspace(&self) -> Workspace {
+        self.workspace
+    }
+}

@@ -1,0 +1,70 @@
+//! The built-in simulated target: the simulated robot (running the firmware's own code) served
+//! on a real pseudo-terminal, with its overhead camera on a local socket — what `pushbot demo`
+//! and the hardware-in-the-loop tests connect to exactly as to a robot and a camera.
+
+use anyhow::{Context, Result};
+use pushbot_sim::camera::live::LiveCameraOptions;
+use pushbot_sim::{PtySim, Scene, SimOptions};
+
+/// A simulated robot and camera serving one scene.
+pub struct SimTarget {
+    sim: PtySim,
+    camera: String,
+}
+
+impl std::fmt::Debug for SimTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SimTarget")
+            .field("port", &self.sim.serial_path())
+            .field("camera", &self.camera)
+            .finish()
+    }
+}
+
+impl SimTarget {
+    /// Serve `scene` with every random draw from `seed`, simulated time running `speed` times
+    /// faster than the wall clock; camera frames are also written to `frames_dir` if given.
+    pub fn start(
+        scene: &Scene,
+        seed: u64,
+        speed: f64,
+        frames_dir: Option<std::path::PathBuf>,
+    ) -> Result<SimTarget> {
+        let sim = PtySim::start(SimOptions {
+            seed,
+            speed,
+            scene: Some(scene.clone()),
+            camera: Some(LiveCameraOptions {
+                frames_dir,
+                ..LiveCameraOptions::default()
+            }),
+            ..SimOptions::default()
+        })
+        .context("starting the built-in simulated target")?;
+        let camera = match sim.camera_addr() {
+            Some(a) => format!("sim:{a}"),
+            None => anyhow::bail!("the simulated target started without its camera"),
+        };
+        Ok(SimTarget { sim, camera })
+    }
+
+    /// The robot's serial port (a pty path): `--port`.
+    pub fn port(&self) -> &str {
+        self.sim.serial_path()
+    }
+
+    /// The camera, as `--camera` spells it (`sim:127.0.0.1:PORT`).
+    pub fn camera(&self) -> &str {
+        &self.camera
+    }
+
+    /// The simulator, for ground truth in tests and reports.
+    pub fn sim(&self) -> &PtySim {
+        &self.sim
+    }
+
+    /// Stop the simulation; returns the error that stopped it, if any.
+    pub fn shutdown(self) -> Result<()> {
+        self.sim.shutdown()
+    }
+}

@@ -1,0 +1,165 @@
+//! The host's closed loop against the simulated target exactly as against hardware: the real
+//! serial link on the sim's pty and the real vision pipeline on the sim's camera socket
+//! ([`pushbot::exec::LiveRobot`]), judged by the simulator's ground truth.
+
+use pushbot::exec::{LiveOptions, LiveRobot, SimTarget};
+use pushbot::strategy::robot_io::RobotIo;
+use pushbot_sim::Scene;
+use pushbot_tests::{SIM_SPEED, angle_diff};
+
+fn target(scene: &Scene, seed: u64) -> SimTarget {
+    SimTarget::start(scene, seed, SIM_SPEED, None).expect("start the simulated target")
+}
+
+/// Options for a target running [`SIM_SPEED`] times faster than real time: a one-second
+/// watchdog in wall time.
+fn options() -> LiveOptions {
+    LiveOptions {
+        watchdog_ms: (1000.0 * SIM_SPEED) as u16,
+        ..LiveOptions::default()
+    }
+}
+
+/// Camera pose against ground truth: within `mm` millimetres and `deg` degrees.
+fn close(seen: pushbot::strategy::sample::Pose2, truth: pushbot_sim::Pose, mm: f64, deg: f64) {
+    let d = (seen.x - truth.x).hypot(seen.y - truth.y) * 1e3;
+    let a = angle_diff(seen.theta, truth.theta).abs().to_degrees();
+    assert!(
+        d <= mm && a <= deg,
+        "camera says ({:.4}, {:.4}, {:.2}°), truth ({:.4}, {:.4}, {:.2}°): {d:.2} mm, {a:.2}°",
+        seen.x,
+        seen.y,
+        seen.theta.to_degrees(),
+        truth.x,
+        truth.y,
+        truth.theta.to_degrees()
+    );
+}
+
+#[test]
+fn primitives_and_poses_through_the_serial_port_and_the_camera() {
+    let scene = Scene::preset("lau-irregular").expect("preset");
+    let t = target(&scene, 3);
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, options()).expect("connect");
+    assert!(
+        robot.calibration().rms_px < 0.5,
+        "calibration RMS {:.3} px",
+        robot.calibration().rms_px
+    );
+    let start = t.sim().truth().pose;
+    close(robot.robot_pose(), start, 3.0, 1.0);
+
+    robot.forward(0.2).expect("forward");
+    let after = t.sim().truth().pose;
+    assert!(
+        ((after.x - start.x).hypot(after.y - start.y) - 0.2).abs() < 0.01,
+        "drove {:.4} m, asked 0.2",
+        (after.x - start.x).hypot(after.y - start.y)
+    );
+    close(robot.robot_pose(), after, 3.0, 1.0);
+
+    robot.spin(std::f64::consts::FRAC_PI_2).expect("spin");
+    let turned = t.sim().truth().pose;
+    assert!(angle_diff(turned.theta, after.theta - std::f64::consts::FRAC_PI_2).abs() > 1.0);
+    close(robot.robot_pose(), turned, 3.0, 1.0);
+
+    // The object's body pose and its marker pose, as the scene places the marker.
+    let truth = t.sim().objects()[0].1;
+    let body = robot.body_pose("object").expect("object seen");
+    close(body, truth, 3.0, 1.5);
+    let m = scene.objects[0].marker.expect("marker");
+    let marker = robot.object_pose();
+    let (s, c) = truth.theta.sin_cos();
+    let expect = pushbot_sim::Pose::new(
+        truth.x + c * m.x - s * m.y,
+        truth.y + s * m.x + c * m.y,
+        truth.theta,
+    );
+    close(marker, expect, 3.0, 1.5);
+    assert!(robot.time() > 1.0, "robot time {}", robot.time());
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}
+
+#[test]
+fn a_push_moves_the_object_and_the_camera_sees_where() {
+    let scene = Scene::preset("lau-irregular").expect("preset");
+    let t = target(&scene, 4);
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, options()).expect("connect");
+    let before = t.sim().objects()[0].1;
+    // Face the object's centre and drive through it.
+    let r = robot.robot_pose();
+    let o = robot.body_pose("object").expect("object seen");
+    let heading = (o.y - r.y).atan2(o.x - r.x);
+    robot.spin(heading - r.theta).expect("spin");
+    let gap = (o.x - r.x).hypot(o.y - r.y);
+    robot.forward(gap + 0.1).expect("push");
+    let after = t.sim().objects()[0].1;
+    let moved = (after.x - before.x).hypot(after.y - before.y);
+    assert!(moved > 0.06, "the object moved only {moved:.4} m");
+    close(
+        robot.body_pose("object").expect("object seen"),
+        after,
+        3.0,
+        1.5,
+    );
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}
+
+#[test]
+fn a_missing_camera_is_a_clear_error() {
+    let scene = Scene::preset("empty").expect("preset");
+    let t = target(&scene, 5);
+    let err = LiveRobot::connect(t.port(), "sim:127.0.0.1:1", &scene, options())
+        .expect_err("no camera there");
+    let msg = format!("{err:#}");
+    assert!(
+        msg.contains("camera") && msg.contains("127.0.0.1:1"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn a_png_frame_of_the_lau_layout_shows_every_marker() {
+    use pushbot::vision::detect::{DetectorKind, make_detector};
+    use pushbot::vision::layout::MarkerLayout;
+    use pushbot::vision::source::open_source;
+
+    let scene = Scene::preset("lau-scissors").expect("preset");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let t = SimTarget::start(&scene, 6, SIM_SPEED, Some(dir.path().to_path_buf()))
+        .expect("start the simulated target");
+    let png = dir.path().join("frame-000001.png");
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while !png.exists() && std::time::Instant::now() < end {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    t.shutdown().expect("sim ran cleanly");
+    // Keep only the first frame (complete: the second exists) and read it as a camera would.
+    for e in std::fs::read_dir(dir.path()).expect("frames") {
+        let p = e.expect("entry").path();
+        if !p.ends_with("frame-000000.png") {
+            std::fs::remove_file(p).expect("remove");
+        }
+    }
+    let mut src = open_source(dir.path().to_str().expect("utf-8"), 30.0).expect("folder");
+    let frame = src.next_frame().expect("read").expect("one frame");
+    let layout = MarkerLayout::from_scene(&scene);
+    let mut det = make_detector(DetectorKind::ApriltagC, &layout.families()).expect("detector");
+    let mut found: Vec<u32> = det
+        .detect(&frame)
+        .expect("detect")
+        .iter()
+        .map(|d| d.id)
+        .collect();
+    found.sort_unstable();
+    let mut expected: Vec<u32> = layout
+        .calibration
+        .iter()
+        .map(|m| m.id)
+        .chain(layout.bodies.iter().map(|b| b.id))
+        .collect();
+    expected.sort_unstable();
+    assert_eq!(found, expected, "markers in the PNG frame");
+}
