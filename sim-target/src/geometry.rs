@@ -100,14 +100,27 @@ pub fn check_simple(outline: &[[f64; 2]]) -> Result<(), ShapeError> {
         .flatten()
         .fold(0.0f64, |m, c| m.max(c.abs()))
         .max(1e-9);
-    if signed_area(outline).abs() < 1e-12 * scale * scale.max(1.0) || n < 3 {
+    // Every vertex on one line: no area (before the crossing test, which would call the
+    // folded edges of such a polygon crossing).
+    let p0 = v(outline[0]);
+    let far = outline
+        .iter()
+        .map(|q| v(*q))
+        .max_by(|a, b| (*a - p0).length().total_cmp(&(*b - p0).length()))
+        .unwrap_or(p0);
+    let axis = far - p0;
+    if outline
+        .iter()
+        .all(|q| axis.perp_dot(v(*q) - p0).abs() <= 1e-12 * scale * scale.max(1.0))
+    {
+        return Err(ShapeError::Degenerate);
+    }
+    // A repeated vertex: a zero-length edge.
+    if (0..n).any(|i| (v(outline[(i + 1) % n]) - v(outline[i])).length() <= 1e-12 * scale) {
         return Err(ShapeError::Degenerate);
     }
     for i in 0..n {
         let (a1, a2) = (v(outline[i]), v(outline[(i + 1) % n]));
-        if (a2 - a1).length() <= 1e-12 * scale {
-            return Err(ShapeError::Degenerate);
-        }
         for j in i + 1..n {
             let (b1, b2) = (v(outline[j]), v(outline[(j + 1) % n]));
             if j == i + 1 || (i == 0 && j == n - 1) {
@@ -127,6 +140,9 @@ pub fn check_simple(outline: &[[f64; 2]]) -> Result<(), ShapeError> {
                 return Err(ShapeError::SelfIntersecting(i, j));
             }
         }
+    }
+    if signed_area(outline).abs() < 1e-12 * scale * scale.max(1.0) {
+        return Err(ShapeError::Degenerate);
     }
     Ok(())
 }

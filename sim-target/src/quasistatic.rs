@@ -90,14 +90,20 @@ pub struct Solution {
     pub moves: Vec<[f64; 3]>,
     /// Normal force (arbitrary units) of each row.
     pub normal: Vec<f64>,
+    /// Friction force of each row (same units, along the normal turned +90°).
+    pub tangent: Vec<f64>,
     /// Largest remaining violation of a linearised constraint, m.
     pub residual: f64,
 }
 
 const MAX_ITERS: usize = 300;
-const TOL: f64 = 1e-13;
+/// Iterations of a bisection probe (warm-started).
+const PROBE_ITERS: usize = 100;
+/// Bisection steps for a jammed robot's feasible fraction (2⁻¹⁰ of a step's motion).
+const BISECTIONS: usize = 10;
+const TOL: f64 = 1e-12;
 /// A step is feasible when every linearised gap is closed to within this, m.
-pub const FEASIBLE: f64 = 1e-12;
+pub const FEASIBLE: f64 = 1e-10;
 /// The solve keeps contacts this far apart (m), so that rounding never makes them overlap.
 pub const SKIN: f64 = 1e-9;
 
@@ -126,10 +132,19 @@ fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 /// Solve with the robot's motion scaled by `scale`.
-fn solve_at(mobiles: &[Mobile], rows: &[Row], drive: &Drive, scale: f64) -> Solution {
+fn solve_at(
+    mobiles: &[Mobile],
+    rows: &[Row],
+    drive: &Drive,
+    scale: f64,
+    warm: Option<&Solution>,
+    max_iters: usize,
+) -> Solution {
     let mut moves = vec![[0.0; 3]; mobiles.len()];
-    let mut ln = vec![0.0; rows.len()];
-    let mut lt = vec![0.0; rows.len()];
+    let (mut ln, mut lt) = match warm {
+        Some(w) => (w.normal.clone(), w.tangent.clone()),
+        None => (vec![0.0; rows.len()], vec![0.0; rows.len()]),
+    };
     // Per-row constants: Jacobians and weights.
     struct Pre {
         jn: [Option<[f64; 3]>; 2],
@@ -200,7 +215,21 @@ fn solve_at(mobiles: &[Mobile], rows: &[Row], drive: &Drive, scale: f64) -> Solu
         }
         g
     };
-    for _ in 0..MAX_ITERS {
+    if warm.is_some() {
+        for (i, r) in rows.iter().enumerate() {
+            apply(&mut moves, r, &pre[i].jn, ln[i]);
+            apply(&mut moves, r, &pre[i].jt, lt[i]);
+        }
+    }
+    let violation = |moves: &[[f64; 3]]| {
+        rows.iter()
+            .zip(&pre)
+            .filter(|(_, p)| p.wn > 0.0)
+            .map(|(r, p)| r.gap - target(r.gap) + p.kin_n + rel(moves, r, r.n))
+            .fold(0.0f64, |m, g| m.max(-g))
+    };
+    let mut last_violation = f64::INFINITY;
+    for it in 0..max_iters {
         let mut change = 0.0f64;
         for (i, r) in rows.iter().enumerate() {
             let p = &pre[i];
@@ -230,6 +259,15 @@ fn solve_at(mobiles: &[Mobile], rows: &[Row], drive: &Drive, scale: f64) -> Solu
         if change < TOL {
             break;
         }
+        // A jam (no feasible motion) shows as a violation that stops shrinking: give up early
+        // and let the caller cut the robot's motion back.
+        if it % 16 == 15 {
+            let v = violation(&moves);
+            if v > FEASIBLE && v > 0.9 * last_violation {
+                break;
+            }
+            last_violation = v;
+        }
     }
     // Rows between the robot and a static body cannot be corrected by the solve: they only
     // must not get worse than they started.
@@ -247,13 +285,16 @@ fn solve_at(mobiles: &[Mobile], rows: &[Row], drive: &Drive, scale: f64) -> Solu
         scale,
         moves,
         normal: ln,
+        tangent: lt,
         residual,
     }
 }
 
 /// Solve one step: the largest fraction (≤ 1) of the robot's commanded motion that the
-/// objects can make room for, and the objects' displacements.
-pub fn solve(mobiles: &[Mobile], rows: &[Row], drive: &Drive) -> Solution {
+/// objects can make room for, and the objects' displacements. `warm`: the forces of a
+/// previous solve with the same rows (in the same order), to start from.
+pub fn solve(mobiles: &[Mobile], rows: &[Row], drive: &Drive, warm: Option<&Solution>) -> Solution {
+    let warm = warm.filter(|w| w.normal.len() == rows.len() && w.tangent.len() == rows.len());
     // The robot against static bodies: the largest fraction that keeps every gap open.
     let mut hi = 1.0f64;
     for r in rows {
@@ -267,16 +308,17 @@ pub fn solve(mobiles: &[Mobile], rows: &[Row], drive: &Drive) -> Solution {
             hi = hi.min((r.gap.max(0.0) / approach).max(0.0));
         }
     }
-    let first = solve_at(mobiles, rows, drive, hi);
+    let first = solve_at(mobiles, rows, drive, hi, warm, MAX_ITERS);
     if first.residual <= FEASIBLE || hi == 0.0 {
         return first;
     }
-    // Jammed: bisect for the largest feasible fraction.
+    // Jammed: bisect for the largest feasible fraction (each probe warm-started from the
+    // last feasible one). Standing still is feasible when nothing overlaps to begin with.
     let mut lo = 0.0;
-    let mut best = solve_at(mobiles, rows, drive, 0.0);
-    for _ in 0..14 {
+    let mut best = solve_at(mobiles, rows, drive, 0.0, None, MAX_ITERS);
+    for _ in 0..BISECTIONS {
         let mid = 0.5 * (lo + hi);
-        let s = solve_at(mobiles, rows, drive, mid);
+        let s = solve_at(mobiles, rows, drive, mid, Some(&best), PROBE_ITERS);
         if s.residual <= FEASIBLE {
             lo = mid;
             best = s;

@@ -47,6 +47,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::robot::Pose;
 
+mod checks;
 pub mod camera;
 pub use camera::CameraSpec;
 pub mod rearrange;
@@ -585,7 +586,7 @@ impl Scene {
                 ));
             }
         }
-        Ok(())
+        self.check_geometry()
     }
 }
 
@@ -691,58 +692,8 @@ pub fn signed_area(outline: &[[f64; 2]]) -> f64 {
         / 2.0
 }
 
-/// Whether two closed segments intersect.
-pub(crate) fn segments_intersect(p1: [f64; 2], p2: [f64; 2], q1: [f64; 2], q2: [f64; 2]) -> bool {
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let on = |o: [f64; 2], a: [f64; 2], p: [f64; 2]| {
-        p[0] >= o[0].min(a[0])
-            && p[0] <= o[0].max(a[0])
-            && p[1] >= o[1].min(a[1])
-            && p[1] <= o[1].max(a[1])
-    };
-    let d1 = cross(q1, q2, p1);
-    let d2 = cross(q1, q2, p2);
-    let d3 = cross(p1, p2, q1);
-    let d4 = cross(p1, p2, q2);
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    (d1 == 0.0 && on(q1, q2, p1))
-        || (d2 == 0.0 && on(q1, q2, p2))
-        || (d3 == 0.0 && on(p1, p2, q1))
-        || (d4 == 0.0 && on(p1, p2, q2))
-}
-
-/// A usable polygon: ≥ 3 finite vertices, non-zero area, no edge crossing another.
+/// A usable polygon: ≥ 3 finite vertices, non-zero area, no zero-length edge, no edge
+/// crossing another ([`crate::geometry::check_simple`]).
 fn check_polygon(outline: &[[f64; 2]]) -> Result<(), String> {
-    let n = outline.len();
-    if n < 3 {
-        return Err(format!("a polygon needs at least 3 vertices, not {n}"));
-    }
-    if outline.iter().flatten().any(|c| !c.is_finite()) {
-        return Err("vertices must be finite".into());
-    }
-    for i in 0..n {
-        for j in i + 1..n {
-            // Adjacent edges share a vertex; skip them.
-            if j == i + 1 || (i == 0 && j == n - 1) {
-                continue;
-            }
-            let (a1, a2) = (outline[i], outline[(i + 1) % n]);
-            let (b1, b2) = (outline[j], outline[(j + 1) % n]);
-            if segments_intersect(a1, a2, b1, b2) {
-                return Err(format!(
-                    "edges {i} and {j} cross: the polygon is not simple"
-                ));
-            }
-        }
-    }
-    if signed_area(outline).abs() < 1e-10 {
-        return Err("the polygon has no area".into());
-    }
-    Ok(())
+    crate::geometry::check_simple(outline).map_err(|e| e.to_string())
 }

@@ -195,6 +195,11 @@ pub struct World {
     object_shapes: Vec<(Outline, f64)>,
     /// Scratch: contacts of the step.
     contacts: Vec<ContactPoint>,
+    /// The last step's rows (bodies of each) and solution, to warm-start the next solve.
+    last: (
+        Vec<(BodyRef, BodyRef)>,
+        Option<crate::quasistatic::Solution>,
+    ),
 }
 
 impl World {
@@ -268,6 +273,7 @@ impl World {
             statics: Vec::new(),
             object_shapes: Vec::new(),
             contacts: Vec::new(),
+            last: (Vec::new(), None),
         }
         .with_walls()
     }
@@ -429,12 +435,12 @@ impl World {
         worst
     }
 
-    /// Gather the contacts closer than `prediction` between the robot at `robot`, the objects
-    /// and the static bodies, as solver rows. Objects whose index is in `only` (all if `None`)
-    /// and the robot take part.
-    fn rows(&mut self, robot: &Pose, prediction: f64, with_robot: bool) -> Vec<Row> {
+    /// Gather the contacts closer than `prediction` as solver rows: the robot at `robot` with
+    /// the walls, obstacles and objects, and, for the objects the robot may move (those it
+    /// touches, and those they touch, and so on), theirs. Objects out of reach of that chain
+    /// cannot move this step and take no part.
+    fn rows(&mut self, robot: &Pose, prediction: f64) -> Vec<Row> {
         let mut rows = Vec::new();
-        let r_robot = self.shape.radius();
         let near = |bb: &[f64; 4], p: &Pose, r: f64| {
             p.x + r + prediction >= bb[0]
                 && p.x - r - prediction <= bb[2]
@@ -442,6 +448,7 @@ impl World {
                 && p.y - r - prediction <= bb[3]
         };
         let push = |rows: &mut Vec<Row>, cs: &mut Vec<ContactPoint>, a, b, mu| {
+            let any = !cs.is_empty();
             for c in cs.drain(..) {
                 rows.push(Row {
                     a,
@@ -453,48 +460,50 @@ impl World {
                     mu,
                 });
             }
+            any
         };
         let mut cs = std::mem::take(&mut self.contacts);
-        if with_robot {
-            for (st, at, bb) in &self.statics {
-                if near(bb, robot, r_robot) {
-                    self.shape.contacts(robot, st, at, prediction, &mut cs);
-                    push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Static, 0.0);
-                }
+        let r_robot = self.shape.radius();
+        for (st, at, bb) in &self.statics {
+            if near(bb, robot, r_robot) {
+                self.shape.contacts(robot, st, at, prediction, &mut cs);
+                push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Static, 0.0);
             }
         }
+        let n = self.objects.len();
+        let mut state = vec![0u8; n]; // 0 out of reach, 1 reached, 2 done
+        let mut queue = Vec::new();
         for (k, ((_, s), (o, _))) in self.objects.iter().zip(&self.object_shapes).enumerate() {
-            if with_robot {
-                self.shape.contacts(robot, o, &s.pose, prediction, &mut cs);
-                push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Object(k), s.mu);
+            self.shape.contacts(robot, o, &s.pose, prediction, &mut cs);
+            if push(&mut rows, &mut cs, BodyRef::Robot, BodyRef::Object(k), s.mu) {
+                state[k] = 1;
+                queue.push(k);
             }
+        }
+        while let Some(k) = queue.pop() {
+            if state[k] == 2 {
+                continue;
+            }
+            state[k] = 2;
+            let (s, o) = (&self.objects[k].1, &self.object_shapes[k].0);
             for (st, at, bb) in &self.statics {
                 if near(bb, &s.pose, o.radius()) {
                     o.contacts(&s.pose, st, at, prediction, &mut cs);
-                    push(
-                        &mut rows,
-                        &mut cs,
-                        BodyRef::Object(k),
-                        BodyRef::Static,
-                        WALL_FRICTION,
-                    );
+                    let (a, b) = (BodyRef::Object(k), BodyRef::Static);
+                    push(&mut rows, &mut cs, a, b, WALL_FRICTION);
                 }
             }
-            for (j, ((_, s2), (o2, _))) in self
-                .objects
-                .iter()
-                .zip(&self.object_shapes)
-                .enumerate()
-                .skip(k + 1)
-            {
+            for (j, st) in state.iter_mut().enumerate() {
+                if j == k || *st == 2 {
+                    continue;
+                }
+                let (s2, o2) = (&self.objects[j].1, &self.object_shapes[j].0);
                 o.contacts(&s.pose, o2, &s2.pose, prediction, &mut cs);
-                push(
-                    &mut rows,
-                    &mut cs,
-                    BodyRef::Object(k),
-                    BodyRef::Object(j),
-                    OBJECT_FRICTION,
-                );
+                let (a, b) = (BodyRef::Object(k), BodyRef::Object(j));
+                if push(&mut rows, &mut cs, a, b, OBJECT_FRICTION) && *st == 0 {
+                    *st = 1;
+                    queue.push(j);
+                }
             }
         }
         self.contacts = cs;
@@ -538,7 +547,7 @@ impl World {
         let reach = (dx * dx + dy * dy).sqrt() + dth.abs() * self.shape.radius();
         let prediction = 2.0 * reach + 1e-4;
         let pose = self.pose;
-        let rows = self.rows(&pose, prediction, true);
+        let rows = self.rows(&pose, prediction);
         if rows.is_empty() {
             self.pressed = 0;
             return (dx, dy, dth, false);
@@ -549,7 +558,17 @@ impl World {
             d: [dx, dy],
             dth,
         };
-        let sol = solve(&mobiles, &rows, &drive);
+        let same = self.last.0.len() == rows.len()
+            && self.last.0.iter().zip(&rows).all(|(p, r)| *p == (r.a, r.b));
+        let sol = solve(
+            &mobiles,
+            &rows,
+            &drive,
+            self.last.1.as_ref().filter(|_| same),
+        );
+        self.last.0.clear();
+        self.last.0.extend(rows.iter().map(|r| (r.a, r.b)));
+        self.last.1 = Some(sol.clone());
         self.move_objects(&sol.moves);
         let k = sol.scale;
         let (ax, ay, dth2) = (k * dx, k * dy, k * dth);
@@ -558,8 +577,12 @@ impl World {
         // mobile body too, so that an object wedged between it and a wall can push it back.
         let (mut ax, mut ay, mut dth2) = (ax, ay, dth2);
         let mut after = Pose::new(pose.x + ax, pose.y + ay, wrap_angle(pose.theta + dth2));
-        for _ in 0..4 {
-            let mut fix = self.rows(&after, 0.0, true);
+        // Translations keep linearised gaps exact or open them (a disc sliding past a corner);
+        // only turning bodies (objects, or a robot that is not round) can close one.
+        let turned = sol.moves.iter().any(|m| m[2] != 0.0)
+            || (self.body.front_plate.is_some() && dth2 != 0.0);
+        for _ in 0..if turned { 4 } else { 0 } {
+            let mut fix = self.rows(&after, 1e-6);
             if fix.iter().all(|r| r.gap >= -1e-12) {
                 break;
             }
@@ -578,7 +601,7 @@ impl World {
                     }
                 }
             }
-            let s = crate::quasistatic::solve(&m, &fix, &Drive::default());
+            let s = crate::quasistatic::solve(&m, &fix, &Drive::default(), None);
             self.move_objects(&s.moves[..robot]);
             let [rx, ry, rth] = s.moves[robot];
             ax += rx;

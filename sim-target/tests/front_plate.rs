@@ -89,9 +89,9 @@ fn square_pushed_squarely_by_the_plate_translates_flush() {
         assert!(touched, "{name}");
         let s = &w.objects()[0].1;
         assert!(s.pose.x > 0.5, "{name}: pushed along: {:?}", s.pose);
-        assert!(s.pose.theta.abs() < 1e-9, "{name}: turned {}", s.pose.theta);
-        assert!((s.pose.y - 0.45 - dy).abs() < 1e-9, "{name}: {:?}", s.pose);
-        assert!(w.pose().theta.abs() < 1e-9);
+        assert!(s.pose.theta.abs() < 1e-7, "{name}: turned {}", s.pose.theta);
+        assert!((s.pose.y - 0.45 - dy).abs() < 1e-7, "{name}: {:?}", s.pose);
+        assert!(w.pose().theta.abs() < 1e-7);
     }
     // The same off-centre push with the round bumper turns the box (so the test can fail).
     let round = Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry);

@@ -1,0 +1,109 @@
+//! The geometric checks of a scene, after its fields parse and are in range: the robot (with its
+//! front plate) starts on the table and clear of obstacles and objects, and no object overlaps
+//! an obstacle or another object. Shapes and overlaps come from parry2d ([`crate::geometry`]);
+//! touching is allowed, overlapping by more than 1 nm is not.
+
+use super::{Invalid, Scene, Seg, invalid};
+use crate::geometry::Outline;
+use crate::robot::Pose;
+use crate::world::Body;
+
+/// Overlaps deeper than this (m) are refused; touching is fine.
+const TOUCH: f64 = 1e-9;
+
+impl Scene {
+    /// The checks that need the shapes (run after the per-field checks, so every polygon here
+    /// is simple and every pose finite).
+    pub(super) fn check_geometry(&self) -> Result<(), Invalid> {
+        use Seg::{Index, Key};
+        let r = &self.robot;
+        if let Some(p) = r.front_plate
+            && !p.valid()
+        {
+            return Err(invalid(
+                vec![Key("robot"), Key("front_plate")],
+                format!(
+                    "needs a positive width and its face ahead of the axle by more than its \
+                     thickness ({} m)",
+                    crate::world::FrontPlate::THICKNESS
+                ),
+            ));
+        }
+        let body = Body {
+            wheel_base: r.wheel_base,
+            wheel_radius: r.wheel_radius,
+            bumper_radius: r.bumper_radius,
+            front_plate: r.front_plate,
+        };
+        let start = vec![Key("robot"), Key("start")];
+        let robot = body
+            .outline()
+            .map_err(|e| invalid(vec![Key("robot")], e.to_string()))?;
+        let (w, h) = (self.table.width, self.table.height);
+        let origin = Pose::default();
+        let walls = [
+            ([1.0, 0.0], Pose::new(0.0, 0.0, 0.0)),
+            ([-1.0, 0.0], Pose::new(w, 0.0, 0.0)),
+            ([0.0, 1.0], Pose::new(0.0, 0.0, 0.0)),
+            ([0.0, -1.0], Pose::new(0.0, h, 0.0)),
+        ];
+        if walls
+            .iter()
+            .any(|(n, at)| robot.overlaps(&r.start, &Outline::half_plane(*n), at, TOUCH))
+        {
+            return Err(invalid(
+                start,
+                "the robot's outline (bumper and front plate) must start on the table",
+            ));
+        }
+        let mut obstacles = Vec::with_capacity(self.obstacles.len());
+        for (i, o) in self.obstacles.iter().enumerate() {
+            let shape = Outline::polygon(&o.outline).map_err(|e| {
+                invalid(
+                    vec![Key("obstacles"), Index(i), Key("outline")],
+                    e.to_string(),
+                )
+            })?;
+            if robot.overlaps(&r.start, &shape, &origin, TOUCH) {
+                return Err(invalid(
+                    start,
+                    format!("the robot starts inside obstacles[{i}]"),
+                ));
+            }
+            obstacles.push(shape);
+        }
+        let mut objects: Vec<Outline> = Vec::with_capacity(self.objects.len());
+        for (i, o) in self.objects.iter().enumerate() {
+            let at = |k| vec![Key("objects"), Index(i), Key(k)];
+            let shape =
+                Outline::polygon(&o.outline).map_err(|e| invalid(at("outline"), e.to_string()))?;
+            for (j, obstacle) in obstacles.iter().enumerate() {
+                if shape.overlaps(&o.pose, obstacle, &origin, TOUCH) {
+                    return Err(invalid(
+                        at("pose"),
+                        format!("the object overlaps obstacles[{j}]"),
+                    ));
+                }
+            }
+            for (j, other) in objects.iter().enumerate() {
+                if shape.overlaps(&o.pose, other, &self.objects[j].pose, TOUCH) {
+                    return Err(invalid(
+                        at("pose"),
+                        format!(
+                            "the object overlaps objects[{j}] ({:?})",
+                            self.objects[j].id
+                        ),
+                    ));
+                }
+            }
+            if shape.overlaps(&o.pose, &robot, &r.start, TOUCH) {
+                return Err(invalid(
+                    at("pose"),
+                    "the object overlaps the robot's start pose",
+                ));
+            }
+            objects.push(shape);
+        }
+        Ok(())
+    }
+}
