@@ -47,8 +47,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::robot::Pose;
 
-mod checks;
 pub mod camera;
+mod checks;
 pub use camera::CameraSpec;
 pub mod rearrange;
 pub mod stable;

@@ -11,9 +11,10 @@ use pushbot_sim::Scene;
 use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
+use crate::exec::{LiveOptions, LiveRobot};
 use crate::strategy::collect::{CollectParams, CollectReport, collect};
-use crate::strategy::deliver::DeliveryParams;
-use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start};
+use crate::strategy::deliver::{DeliveryParams, deliver_dipole, deliver_learned};
+use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start, summarise};
 use crate::strategy::figures;
 use crate::strategy::obstacles;
 use crate::strategy::regression::{KernelParams, PushStrategy};
@@ -164,9 +165,24 @@ pub struct DeliveryArgs {
     /// Time limit of one trial, s of simulated time (the paper: 8 minutes).
     #[arg(long, default_value_t = 480.0)]
     pub time_limit: f64,
-    /// Run on the robot through the serial port and the camera (not available yet).
+    /// Run on the robot through the serial port and the camera (`--port`, `--camera`): collect
+    /// (unless `--strategy`) and deliver the one live object from where it is to the goal,
+    /// `--trials` times, with one `--method`.
     #[arg(long)]
     pub hil: bool,
+    /// With `--hil`: the robot's serial port.
+    #[arg(long)]
+    pub port: Option<String>,
+    /// With `--hil`: the camera (a device, an image folder, a video, or `sim:HOST:PORT`).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// With `--hil`: the robot's link watchdog, ms of robot time.
+    #[arg(long, default_value_t = 1000)]
+    pub watchdog_ms: u16,
+    /// Collection's evaluation stops after this many straight successful queries (0: initial
+    /// collection only).
+    #[arg(long, default_value_t = 10)]
+    pub streak: usize,
     /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG.
     #[arg(long)]
     pub svg: Option<PathBuf>,
@@ -388,14 +404,13 @@ fn fig11_table(evals: &[SceneEval], starts: &[String], methods: &[Method]) -> St
 /// Run `pushbot eval`.
 pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     let EvalCmd::Delivery(a) = a.cmd;
-    if a.hil {
-        return Err(CliError::bad_input(
-            "--hil (serial link and camera) is not implemented yet; run without it for the \
-             in-process simulation",
-        ));
-    }
     if !(a.time_limit.is_finite() && a.time_limit > 0.0) {
         return Err(CliError::bad_input("--time-limit must be positive"));
+    }
+    if a.hil {
+        let scene =
+            Scene::preset_or_file(&a.scene).map_err(|e| CliError::bad_input(e.to_string()))?;
+        return run_hil(global, &a, &scene);
     }
     let starts = parse_starts(&a.start).map_err(CliError::bad_input)?;
     let names: Vec<String> = if a.scene.trim() == "lau-all" {
@@ -451,6 +466,7 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
         // or collected here first.
         let params = CollectParams {
             initial: a.initial,
+            streak: a.streak,
             seed: global.seed,
             ..CollectParams::default()
         };
@@ -558,6 +574,116 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
         print!("{}", fig11_table(&evals, &starts, &methods));
     }
     Ok(if learned_ok {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
+}
+
+/// `eval delivery --hil`: collect (or load) and deliver through the serial port and the camera.
+/// The live object cannot be put back at a start position, so each trial delivers it from
+/// wherever it is to the scene's goal, with one method.
+fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
+    let (Some(port), Some(camera)) = (a.port.as_deref(), a.camera.as_deref()) else {
+        return Err(CliError::bad_input("--hil needs --port and --camera"));
+    };
+    let method = match a.method {
+        MethodArg::Learned => Method::Learned,
+        MethodArg::Dipole => Method::Dipole,
+        MethodArg::Both => {
+            return Err(CliError::bad_input(
+                "--hil runs one method on the one live object: --method learned or dipole",
+            ));
+        }
+    };
+    let opts = LiveOptions {
+        boundary_inset: a.sim.boundary_inset,
+        object: a.object.clone(),
+        watchdog_ms: a.watchdog_ms,
+        ..LiveOptions::default()
+    };
+    let mut io = LiveRobot::connect(port, camera, scene, opts).map_err(CliError::Failed)?;
+    let goal = obstacles::scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
+    let kernel = a.sim.kernel()?;
+    let delivery = DeliveryParams {
+        time_limit: a.time_limit,
+        ..DeliveryParams::default()
+    };
+    let mut collection = None;
+    let samples: Vec<Sample> = match (method, &a.strategy) {
+        (Method::Dipole, _) => Vec::new(),
+        (Method::Learned, Some(path)) => {
+            store::load(path)
+                .map_err(|e| CliError::bad_input(e.to_string()))?
+                .samples
+        }
+        (Method::Learned, None) => {
+            let params = CollectParams {
+                initial: a.initial,
+                streak: a.streak,
+                seed: global.seed,
+                ..CollectParams::default()
+            };
+            let mut strategy = PushStrategy::new(Vec::new(), kernel);
+            let pb = progress_bar(global, params.initial as u64);
+            let rep = collect(&mut io, &mut strategy, &params, &mut |_| Ok(()), &pb)?;
+            pb.finish_and_clear();
+            collection = Some(rep);
+            strategy.samples().to_vec()
+        }
+    };
+    let mut runs = Vec::new();
+    for _ in 0..a.trials {
+        let d = match method {
+            Method::Learned => {
+                let mut strat = PushStrategy::new(samples.iter().copied(), kernel);
+                if scene.obstacles.is_empty() {
+                    deliver_learned(&mut io, &mut strat, goal, &delivery, &mut |_| Ok(()))?
+                } else {
+                    obstacles::deliver_among_obstacles(
+                        &mut io,
+                        &mut strat,
+                        goal,
+                        &obstacles::scene_obstacles(scene),
+                        &delivery,
+                        &obstacles::ObstacleParams::default(),
+                        &mut |_| Ok(()),
+                    )?
+                    .delivery
+                }
+            }
+            Method::Dipole => deliver_dipole(&mut io, goal, &delivery)?,
+        };
+        runs.push(d);
+    }
+    let res = summarise("live", method, &runs);
+    if global.json {
+        println!(
+            "{}",
+            json!({
+                "hil": true,
+                "trials": a.trials,
+                "scenes": [{
+                    "scene": scene.name,
+                    "samples": samples.len(),
+                    "collection": collection,
+                    "results": [res],
+                }],
+            })
+        );
+    } else {
+        println!(
+            "{} live {:?}: {:.0} % of {} | samples {} | final distance {}",
+            scene.name,
+            method,
+            res.success_rate,
+            res.trials,
+            samples.len(),
+            runs.last()
+                .map_or("-".into(), |d| format!("{:.3} m", d.final_distance)),
+        );
+    }
+    Ok(if res.success_rate >= 95.0 {
         Status::Success
     } else {
         Status::TaskFailed

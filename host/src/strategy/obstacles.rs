@@ -352,7 +352,7 @@ pub fn collect_or_load(
 ) -> Result<(Vec<Sample>, Option<CollectReport>)> {
     if cache.exists() {
         let file = store::load(cache)?;
-        if file.samples.len() >= params.initial.min(20).max(1) {
+        if file.samples.len() >= params.initial.clamp(1, 20) {
             return Ok((file.samples, None));
         }
     }
@@ -389,6 +389,8 @@ pub struct SceneDelivery {
 /// Collect (or reuse the cached strategy in `cache`), then deliver the object of `scene` to its
 /// goal among the scene's obstacles, in the in-process simulation: the library entry point of
 /// the demo. `object`: the object's id (the scene's first when `None`).
+// Each argument is a separate, independently defaulted setting of one of the two algorithms.
+#[allow(clippy::too_many_arguments)]
 pub fn collect_and_deliver(
     scene: &Scene,
     object: Option<&str>,
