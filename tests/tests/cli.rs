@@ -190,3 +190,35 @@ fn piped_into_head_gives_one_line_and_no_noise() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn logs_go_to_stderr_at_the_level_of_v() {
+    // Quiet by default: only the result, on stdout.
+    let r = pushbot_tests::run_bin("pushbot", &["--json", "robot", "info", "--seed", "3"]);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    assert!(!r.stderr.contains("built-in simulated robot"), "{r:?}");
+    let v: serde_json::Value = serde_json::from_str(r.stdout.trim()).expect("one JSON object");
+    assert_eq!(v["simulated"], true, "{v}");
+    // -v: info logs on stderr, stdout still one JSON object; --scene picks the sim's world.
+    let r = pushbot_tests::run_bin(
+        "pushbot",
+        &["-v", "robot", "info", "--json", "--scene", "three-boxes"],
+    );
+    assert_eq!(r.code, Some(0), "{r:?}");
+    assert!(r.stderr.contains("INFO"), "{r:?}");
+    assert!(
+        r.stderr.contains("built-in simulated robot on /dev/pts/"),
+        "{r:?}"
+    );
+    let v: serde_json::Value = serde_json::from_str(r.stdout.trim()).expect("one JSON object");
+    assert_eq!(v["command"], "info", "{v}");
+}
+
+#[test]
+fn exit_codes_are_in_the_top_level_help() {
+    let r = pushbot_tests::run_bin("pushbot", &["--help"]);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    for needle in ["Exit status: 0 success", "1 the task failed", "2 bad input"] {
+        assert!(r.stdout.contains(needle), "{needle}: {}", r.stdout);
+    }
+}

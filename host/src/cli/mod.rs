@@ -191,9 +191,28 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ("scene list", "pushbot scene list"),
 ];
 
+/// The exit codes, as `pushbot --help` states them.
+const EXIT_CODES: &str = "\n\nExit status: 0 success; 1 the task failed (no plan exists, goal not \
+     reached, the robot faulted, the link died); 2 bad input (arguments, files, devices).\n\
+     Logs go to stderr (-v info, -vv debug, -vvv trace, or PUSHBOT_LOG=<filter>).";
+
+/// Report a task that ran but failed with `message` (exit code 1 follows): `error: …` on
+/// stderr, and with `--json` the same error object on stdout as [`main`] prints.
+pub fn task_failed(g: &Global, message: &str) -> Status {
+    eprintln!("error: {message}");
+    if g.json {
+        print_json_error("failed", message, 1);
+    }
+    Status::TaskFailed
+}
+
 fn with_examples(mut cmd: clap::Command, path: &str) -> clap::Command {
     if let Some((_, ex)) = EXAMPLES.iter().find(|(p, _)| *p == path) {
-        cmd = cmd.after_help(format!("Example:\n  {ex}"));
+        let mut help = format!("Example:\n  {ex}");
+        if path.is_empty() {
+            help.push_str(EXIT_CODES);
+        }
+        cmd = cmd.after_help(help);
     }
     let names: Vec<String> = cmd
         .get_subcommands()

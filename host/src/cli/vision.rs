@@ -137,10 +137,7 @@ pub fn calibrate(g: &Global, args: CalibrateArgs) -> CliResult {
     let mut src = source(&args.camera)?;
     let cal = match calibrate_from(src.as_mut(), &args.camera, &lay, args.frames)? {
         Ok(c) => c,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return Ok(Status::TaskFailed);
-        }
+        Err(msg) => return Ok(super::task_failed(g, &msg)),
     };
     cal.save(&args.out)
         .map_err(|e| CliError::Failed(e.into()))?;
@@ -178,10 +175,7 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
         Some(c) => c,
         None => match calibrate_from(src.as_mut(), &args.camera, &lay, 1)? {
             Ok(c) => c,
-            Err(msg) => {
-                eprintln!("error: {msg}");
-                return Ok(Status::TaskFailed);
-            }
+            Err(msg) => return Ok(super::task_failed(g, &msg)),
         },
     };
     let det = make_detector(args.camera.detector, &lay.families())
