@@ -9,5 +9,7 @@ pub mod exec;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
+pub mod plot;
+pub mod report;
 pub mod strategy;
 pub mod vision;

@@ -112,9 +112,9 @@ fn learned_delivery_succeeds_from_two_starts_and_dipole_runs_beside_it() {
 #[test]
 fn reset_robot_obj_boundary_brings_the_object_back() {
     let mut scene = Scene::preset("lau-irregular").unwrap();
-    // Object 8 cm past the lower boundary (inset 0.2 m), robot above it.
-    scene.objects[0].pose = Pose::new(0.8, 0.12, 0.3);
-    scene.robot.start = Pose::new(0.8, 0.3, -1.5);
+    // Object 3.5 cm past the lower boundary (inset 0.1 m), robot above it.
+    scene.objects[0].pose = Pose::new(0.8, 0.065, 0.3);
+    scene.robot.start = Pose::new(0.8, 0.25, -1.5);
     let mut io = SimRobot::new(scene, None, None, SimRobotOptions::default()).unwrap();
     let ws = io.workspace();
     assert!(!ws.boundary.contains(io.object_pose().position()));
@@ -150,4 +150,80 @@ fn delivery_adds_supplemental_samples_at_once() {
     assert!(!added.is_empty());
     assert_eq!(strat.len(), samples.len() + added.len());
     assert_eq!(&strat.samples()[samples.len()..], &added[..]);
+}
+
+#[test]
+fn collect_once_then_deliver_around_a_wall_from_the_cache() {
+    use pushbot::strategy::obstacles::{
+        ObstacleParams, clearance, collect_and_deliver, collect_or_load, scene_obstacles,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("irregular.strategy");
+    let scene = Scene::preset("lau-obstacles").unwrap();
+    let sim = SimRobotOptions {
+        seed: 4,
+        ..SimRobotOptions::default()
+    };
+    let params = initial_only(160, 4);
+    let pb = ProgressBar::hidden();
+    // First call collects (on the table without the wall) and writes the cache …
+    let (first, rep) = collect_or_load(
+        &scene,
+        None,
+        &cache,
+        sim,
+        &params,
+        KernelParams::default(),
+        &pb,
+    )
+    .unwrap();
+    assert_eq!(rep.unwrap().initial_samples, 160);
+    // … the second reuses it.
+    let (again, rep) = collect_or_load(
+        &scene,
+        None,
+        &cache,
+        sim,
+        &params,
+        KernelParams::default(),
+        &pb,
+    )
+    .unwrap();
+    assert!(rep.is_none());
+    assert_eq!(first, again);
+    let out = collect_and_deliver(
+        &scene,
+        None,
+        &cache,
+        sim,
+        &params,
+        &DeliveryParams::default(),
+        &ObstacleParams::default(),
+        &pb,
+    )
+    .unwrap();
+    assert!(out.collection.is_none());
+    let d = &out.result.delivery;
+    assert!(
+        d.success,
+        "{:?} after sub-goals {:?}",
+        d.failure, out.result.subgoals
+    );
+    assert!(d.final_distance < 0.022);
+    // The global path keeps the object's bounding circle off the wall, and the object really
+    // went around the wall's lower end (x 0.78–0.88 m, y ≥ 0.45 m).
+    let wall = scene_obstacles(&scene);
+    for q in &out.result.path {
+        assert!(clearance(Vector2::new(q[0], q[1]), &wall) > 0.07, "{q:?}");
+    }
+    let (start, goal) = (out.start.position(), Vector2::new(1.25, 0.6));
+    assert!(start.x < 0.78 && goal.x > 0.88);
+    let crossing = d
+        .trajectory
+        .iter()
+        .map(|(_, o)| o.position())
+        .find(|o| (0.78..=0.88).contains(&o.x))
+        .expect("the object passed the wall's x");
+    assert!(crossing.y < 0.45, "crossed at {crossing:?}");
+    assert!(out.result.subgoals.len() >= 3, "{:?}", out.result.subgoals);
 }

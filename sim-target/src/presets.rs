@@ -6,7 +6,8 @@
 //!   `lau-snake` — the six objects of Lau, Mitani & Igarashi (Fig. 6: robot and objects of
 //!   5–15 cm; the irregular shape once with its marker near the middle, once near a corner) in
 //!   their test layout (Fig. 10): a bounded table, start positions `A`–`F` (the object starts
-//!   at `A`), one goal.
+//!   at `A`), one goal. `lau-obstacles`: the irregular object's layout with a wall between
+//!   start and goal (delivery among obstacles, §III-E).
 //! * `bsr-a` … `bsr-d` — Ben-Shahar & Rivlin's test cases A–D: boxes in rooms joined by doors
 //!   (A: two boxes to move to the other room; B: two boxes to exchange in a corridor; C: a
 //!   complex (U-shaped) movable through a door; D: an L-shaped movable in a cluttered room),
@@ -23,6 +24,7 @@ pub const NAMES: &[&str] = &[
     "lau-wire-cutter",
     "lau-scissors",
     "lau-snake",
+    "lau-obstacles",
     "bsr-a",
     "bsr-b",
     "bsr-c",
@@ -54,6 +56,10 @@ pub fn text(name: &str) -> Option<String> {
             "{ kind = \"points\", points = [[0.06, 0.0], [-0.045, 0.025], [-0.045, -0.025]] }",
         ),
         "lau-snake" => lau(name, SNAKE, [0.0, 0.0], 0.1, SUPPORT_UNIFORM),
+        // The irregular object at A behind a wall from the top edge down to y = 0.45 m.
+        "lau-obstacles" => {
+            lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &obstacle(7.8, 4.5, 8.8, 12.0)
+        }
         "bsr-a" => bsr_a(),
         "bsr-b" => bsr_b(),
         "bsr-c" => bsr_c(),

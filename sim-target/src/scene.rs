@@ -49,6 +49,7 @@ use crate::robot::Pose;
 
 pub mod camera;
 pub use camera::CameraSpec;
+pub mod rearrange;
 
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,6 +78,9 @@ pub struct Scene {
     /// The overhead camera: image, robot marker, calibration markers.
     #[serde(default)]
     pub camera: CameraSpec,
+    /// Grid rearrangement planning settings (see [`rearrange`]); the simulator ignores them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rearrange: Option<rearrange::Rearrange>,
 }
 
 /// The table: a rectangle with its origin at the lower-left corner; its edges are walls.

@@ -95,6 +95,7 @@ impl SimOptions {
                 goals: Vec::new(),
                 positions: Vec::new(),
                 camera: crate::scene::CameraSpec::default(),
+                rearrange: None,
             },
         }
     }

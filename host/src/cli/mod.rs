@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
+pub mod demo;
 pub mod rearrange;
 pub mod robot;
 pub mod scene;
@@ -44,6 +45,9 @@ pub struct Cli {
 /// The commands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// The whole system in one command: the built-in simulated target (or --port/--camera),
+    /// a learned delivery, a rearrangement and a stable push, and a report folder.
+    Demo(demo::DemoArgs),
     /// Talk to the robot: info, move, spin, stop, estop, clear-faults.
     Robot(robot::RobotArgs),
     /// Pushing mechanics of an object: STABLE per edge, controllability (Lynch & Mason §3).
@@ -292,6 +296,7 @@ fn init_logging(verbose: u8) {
 pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
     match command {
+        Command::Demo(args) => demo::run(&global, args),
         Command::Robot(args) => robot::run(&global, args),
         Command::Mechanics(a) => stable::run_mechanics(&global, &a),
         Command::Plan(PlanCommand::Rearrange(args)) => rearrange::plan(&global, args),

@@ -21,6 +21,9 @@ pub struct PlanArgs {
     /// Write the plan as step-by-step figures (SVG) to this file.
     #[arg(long)]
     pub svg: Option<std::path::PathBuf>,
+    /// Write the same figures as a PNG picture to this file.
+    #[arg(long)]
+    pub png: Option<std::path::PathBuf>,
 }
 
 /// Arguments of `pushbot bench rearrange`.
@@ -89,10 +92,16 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
     let st = &map.stats;
     match &result {
         Ok(p) => {
-            if let Some(path) = &args.svg {
-                std::fs::write(path, rearrange::svg::plan_svg(&model, p)).map_err(|e| {
-                    CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display()))
-                })?;
+            if args.svg.is_some() || args.png.is_some() {
+                let svg = rearrange::svg::plan_svg(&model, p);
+                if let Some(path) = &args.svg {
+                    std::fs::write(path, &svg).map_err(|e| {
+                        CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display()))
+                    })?;
+                }
+                if let Some(path) = &args.png {
+                    crate::plot::svg_to_png(&svg, path).map_err(CliError::Failed)?;
+                }
             }
             if global.json {
                 let j = json!({

@@ -15,6 +15,7 @@ use crate::strategy::collect::{CollectParams, CollectReport, collect};
 use crate::strategy::deliver::DeliveryParams;
 use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start};
 use crate::strategy::figures;
+use crate::strategy::obstacles;
 use crate::strategy::regression::{KernelParams, PushStrategy};
 use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::Sample;
@@ -30,8 +31,11 @@ pub struct SimArgs {
     #[arg(long, default_value_t = 0.5)]
     pub noise_deg: f64,
     /// How far inside the table edge the object's boundary lies, m.
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(long, default_value_t = 0.1)]
     pub boundary_inset: f64,
+    /// Extra simulated table beyond the scene's on every side (room for the robot), m.
+    #[arg(long, default_value_t = 0.25)]
+    pub table_margin: f64,
     /// Kernel width K_w of the regression, m (the paper: 8 px ≈ 1.8 cm).
     #[arg(long, default_value_t = 0.018)]
     pub kernel_width: f64,
@@ -53,6 +57,7 @@ impl SimArgs {
             position_noise: self.noise_mm * 1e-3,
             heading_noise: self.noise_deg.to_radians(),
             boundary_inset: self.boundary_inset,
+            table_margin: self.table_margin,
             ..SimRobotOptions::default()
         })
     }
@@ -128,7 +133,9 @@ pub enum MethodArg {
 /// `pushbot eval delivery`.
 #[derive(Args, Debug)]
 pub struct DeliveryArgs {
-    /// Scene preset or file (e.g. lau-irregular).
+    /// Scene preset or file (e.g. lau-irregular), several separated by commas, or `lau-all`
+    /// for the six objects of Lau et al.; scenes with obstacles are delivered along a global
+    /// path (learned method).
     #[arg(long)]
     pub scene: String,
     /// Object id in the scene (default: the first).
@@ -143,9 +150,14 @@ pub struct DeliveryArgs {
     /// Trials per start position and method.
     #[arg(long, default_value_t = 10)]
     pub trials: usize,
-    /// Pushing strategy file; without it one is collected in the simulation first.
+    /// Pushing strategy file (one scene); without it or `--strategy-dir` one is collected in
+    /// the simulation first.
     #[arg(long)]
     pub strategy: Option<PathBuf>,
+    /// Directory of cached strategies `<scene>.strategy`: loaded when present, otherwise
+    /// collected (Algorithm 1, initial + evaluation) and written there.
+    #[arg(long)]
+    pub strategy_dir: Option<PathBuf>,
     /// K of the collection when no strategy file is given.
     #[arg(long, default_value_t = 300)]
     pub initial: usize,
@@ -313,6 +325,66 @@ fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
     .unwrap_or_default()
 }
 
+/// The six objects of Lau et al. (Fig. 6), as preset scenes, in the order of their Fig. 11.
+pub const LAU_SCENES: &[&str] = &[
+    "lau-irregular",
+    "lau-irregular-corner",
+    "lau-l-shape",
+    "lau-wire-cutter",
+    "lau-scissors",
+    "lau-snake",
+];
+
+/// One scene's evaluation.
+#[derive(Debug, serde::Serialize)]
+struct SceneEval {
+    scene: String,
+    samples: usize,
+    collection: Option<CollectReport>,
+    results: Vec<StartResult>,
+}
+
+/// The table of Lau et al. Fig. 11: success % per start (rows) and scene × method (columns).
+fn fig11_table(evals: &[SceneEval], starts: &[String], methods: &[Method]) -> String {
+    use std::fmt::Write;
+    let mut t = String::new();
+    let short = |s: &str| s.strip_prefix("lau-").unwrap_or(s).to_owned();
+    let name = |m: &Method| match m {
+        Method::Learned => "ours",
+        Method::Dipole => "dipole",
+    };
+    let _ = write!(t, "{:<6}", "start");
+    for e in evals {
+        let w = 9 * methods.len();
+        let _ = write!(t, "| {:<w$}", short(&e.scene));
+    }
+    t.push('\n');
+    let _ = write!(t, "{:<6}", "");
+    for _ in evals {
+        t.push_str("| ");
+        for m in methods {
+            let _ = write!(t, "{:<9}", name(m));
+        }
+    }
+    t.push('\n');
+    for s in starts {
+        let _ = write!(t, "{s:<6}");
+        for e in evals {
+            t.push_str("| ");
+            for m in methods {
+                let cell = e
+                    .results
+                    .iter()
+                    .find(|r| &r.start == s && r.method == *m)
+                    .map_or("-".to_owned(), |r| format!("{:.0}", r.success_rate));
+                let _ = write!(t, "{cell:<9}");
+            }
+        }
+        t.push('\n');
+    }
+    t
+}
+
 /// Run `pushbot eval`.
 pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     let EvalCmd::Delivery(a) = a.cmd;
@@ -326,100 +398,164 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
         return Err(CliError::bad_input("--time-limit must be positive"));
     }
     let starts = parse_starts(&a.start).map_err(CliError::bad_input)?;
-    let scene = Scene::preset_or_file(&a.scene).map_err(|e| CliError::bad_input(e.to_string()))?;
-    for s in &starts {
-        if scene.position(s).is_none() {
-            return Err(CliError::bad_input(format!(
-                "scene {} has no start position {s}",
-                scene.name
-            )));
+    let names: Vec<String> = if a.scene.trim() == "lau-all" {
+        LAU_SCENES.iter().map(|s| (*s).to_owned()).collect()
+    } else {
+        a.scene
+            .split(',')
+            .map(|s| s.trim().to_owned())
+            .filter(|s| !s.is_empty())
+            .collect()
+    };
+    if names.is_empty() {
+        return Err(CliError::bad_input("no scene given"));
+    }
+    if names.len() > 1 && a.strategy.is_some() {
+        return Err(CliError::bad_input(
+            "--strategy is one file for one scene; use --strategy-dir with several scenes",
+        ));
+    }
+    let mut scenes = Vec::new();
+    for n in &names {
+        let scene = Scene::preset_or_file(n).map_err(|e| CliError::bad_input(e.to_string()))?;
+        for s in &starts {
+            if scene.position(s).is_none() {
+                return Err(CliError::bad_input(format!(
+                    "scene {} has no start position {s}",
+                    scene.name
+                )));
+            }
         }
+        scenes.push(scene);
     }
     let methods: Vec<Method> = match a.method {
         MethodArg::Learned => vec![Method::Learned],
         MethodArg::Dipole => vec![Method::Dipole],
-        MethodArg::Both => vec![Method::Learned, Method::Dipole],
+        MethodArg::Both => vec![Method::Dipole, Method::Learned],
     };
-    let setup = TrialSetup {
-        scene: scene.clone(),
-        object: a.object.clone(),
-        sim: a.sim.options(global.seed)?,
-        delivery: DeliveryParams {
-            time_limit: a.time_limit,
-            ..DeliveryParams::default()
-        },
-        kernel: a.sim.kernel()?,
-    };
-    setup.goal().map_err(CliError::BadInput)?;
-    // The strategy: from a file, or collected here first.
-    let mut collection = None;
-    let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
-        Vec::new()
-    } else if let Some(path) = &a.strategy {
-        store::load(path)
-            .map_err(|e| CliError::bad_input(e.to_string()))?
-            .samples
-    } else {
+    let mut evals = Vec::new();
+    let mut trajectories = Vec::new();
+    for (name, scene) in names.iter().zip(&scenes) {
+        let setup = TrialSetup {
+            scene: scene.clone(),
+            object: a.object.clone(),
+            sim: a.sim.options(global.seed)?,
+            delivery: DeliveryParams {
+                time_limit: a.time_limit,
+                ..DeliveryParams::default()
+            },
+            kernel: a.sim.kernel()?,
+        };
+        setup.goal().map_err(CliError::BadInput)?;
+        // The strategy: from a file, from the cache directory (collected there when missing),
+        // or collected here first.
         let params = CollectParams {
             initial: a.initial,
             seed: global.seed,
             ..CollectParams::default()
         };
-        let (strat, rep) = collect_in_sim(
-            global,
-            scene.clone(),
-            a.object.as_deref(),
-            &a.sim,
-            &params,
-            Vec::new(),
-            None,
-        )?;
-        collection = Some(rep);
-        strat.samples().to_vec()
-    };
-    let mut results: Vec<StartResult> = Vec::new();
-    let mut trajectories = Vec::new();
-    for s in &starts {
-        for &m in &methods {
-            let (res, runs) = run_start(&setup, m, &samples, s, a.trials)?;
-            if let Some(first) = runs.into_iter().next() {
-                trajectories.push((format!("{s} {m:?}"), first.trajectory));
+        let mut collection = None;
+        let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
+            Vec::new()
+        } else if let Some(path) = &a.strategy {
+            store::load(path)
+                .map_err(|e| CliError::bad_input(e.to_string()))?
+                .samples
+        } else if let Some(dir) = &a.strategy_dir {
+            std::fs::create_dir_all(dir).map_err(|e| {
+                CliError::bad_input(format!("cannot create {}: {e}", dir.display()))
+            })?;
+            let file = dir.join(format!("{}.strategy", name.replace(['/', '.'], "_")));
+            let pb = progress_bar(global, params.initial as u64);
+            let (samples, rep) = obstacles::collect_or_load(
+                scene,
+                a.object.as_deref(),
+                &file,
+                setup.sim,
+                &params,
+                setup.kernel,
+                &pb,
+            )
+            .map_err(CliError::Failed)?;
+            pb.finish_and_clear();
+            collection = rep;
+            samples
+        } else {
+            let mut clear = scene.clone();
+            clear.obstacles.clear();
+            let (strat, rep) = collect_in_sim(
+                global,
+                clear,
+                a.object.as_deref(),
+                &a.sim,
+                &params,
+                Vec::new(),
+                None,
+            )?;
+            collection = Some(rep);
+            strat.samples().to_vec()
+        };
+        let mut results: Vec<StartResult> = Vec::new();
+        for s in &starts {
+            for &m in &methods {
+                let (res, runs) = run_start(&setup, m, &samples, s, a.trials)?;
+                if let Some(first) = runs.into_iter().next()
+                    && names.len() == 1
+                {
+                    trajectories.push((format!("{s} {m:?}"), first.trajectory));
+                }
+                if !global.json {
+                    println!(
+                        "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?}",
+                        scene.name,
+                        res.start,
+                        format!("{m:?}"),
+                        res.success_rate,
+                        res.trials,
+                        res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
+                        res.mean_object_path_m
+                            .map_or("-".into(), |t| format!("{t:.2} m")),
+                        res.failures,
+                    );
+                }
+                results.push(res);
             }
-            if !global.json {
-                println!(
-                    "{} {:>7}: {:>5.1} % of {} | time {} | object path {}",
-                    res.start,
-                    format!("{m:?}"),
-                    res.success_rate,
-                    res.trials,
-                    res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
-                    res.mean_object_path_m
-                        .map_or("-".into(), |t| format!("{t:.2} m")),
-                );
-            }
-            results.push(res);
         }
+        evals.push(SceneEval {
+            scene: scene.name.clone(),
+            samples: samples.len(),
+            collection,
+            results,
+        });
     }
     if let Some(svg) = &a.svg {
-        let goal = setup.goal().map_err(CliError::BadInput)?;
-        let text = figures::trajectories_svg(&trajectories, &scene, goal);
-        std::fs::write(svg, text)
-            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
+        if let [scene] = scenes.as_slice() {
+            let goal =
+                obstacles::scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
+            let text = figures::trajectories_svg(&trajectories, scene, goal);
+            std::fs::write(svg, text)
+                .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
+        } else {
+            return Err(CliError::bad_input("--svg draws one scene's trajectories"));
+        }
     }
-    let learned_ok = results
+    let learned_ok = evals
         .iter()
+        .flat_map(|e| &e.results)
         .filter(|r| r.method == Method::Learned)
         .all(|r| r.success_rate >= 95.0);
     if global.json {
         println!(
             "{}",
             json!({
-                "scene": scene.name,
-                "samples": samples.len(),
-                "collection": collection,
-                "results": results,
+                "trials": a.trials,
+                "starts": starts,
+                "scenes": evals,
             })
         );
+    } else {
+        println!("\nSuccess % of {} trials (Lau et al. Fig. 11):", a.trials);
+        print!("{}", fig11_table(&evals, &starts, &methods));
     }
     Ok(if learned_ok {
         Status::Success

@@ -8,6 +8,7 @@
 
 pub mod grabber;
 pub mod live;
+pub mod record;
 pub mod target;
 
 pub use live::{LiveOptions, LiveRobot};

@@ -58,10 +58,8 @@ impl Default for CollectParams {
             streak: 10,
             max_queries: 80,
             goal_min_distance: 0.25,
-            delivery: DeliveryParams {
-                time_limit: 240.0,
-                ..DeliveryParams::default()
-            },
+            // over_time_limit(): the paper's 8 minutes, as in its trials.
+            delivery: DeliveryParams::default(),
             seed: 1,
         }
     }
@@ -84,6 +82,8 @@ pub struct CollectReport {
     pub queries: usize,
     /// Successful queries.
     pub successes: usize,
+    /// Failed queries by reason.
+    pub failures: std::collections::BTreeMap<String, usize>,
     /// Whether the last `streak` queries all succeeded.
     pub streak_reached: bool,
     /// Simulated (or real) minutes of the initial collection.
@@ -269,6 +269,9 @@ pub fn collect(
             streak += 1;
         } else {
             streak = 0;
+            if let Some(f) = d.failure {
+                *rep.failures.entry(format!("{f:?}")).or_insert(0) += 1;
+            }
         }
         needs_reset = matches!(d.failure, Some(Failure::TimeLimit));
         progress(pb, strategy, &rep, io.time() - t0);

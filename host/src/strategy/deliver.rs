@@ -74,6 +74,8 @@ pub enum Failure {
     TimeLimit,
     /// The strategy had no answer (no samples).
     NoStrategy,
+    /// Among obstacles: no global path for the object.
+    NoPath,
 }
 
 /// How one delivery went.

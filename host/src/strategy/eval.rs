@@ -9,6 +9,7 @@ use nalgebra::Vector2;
 use pushbot_sim::Scene;
 
 use super::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
+use super::obstacles::{ObstacleParams, deliver_among_obstacles, scene_obstacles};
 use super::regression::{KernelParams, PushStrategy};
 use super::robot_io::{SimRobot, SimRobotOptions};
 use super::sample::Sample;
@@ -100,7 +101,8 @@ impl TrialSetup {
 }
 
 /// Run `trials` deliveries from `start` with `method`; the learned method starts each trial
-/// from `samples` (supplemental samples are used within a trial, not carried to the next).
+/// from `samples` (supplemental samples are used within a trial, not carried to the next) and,
+/// in a scene with obstacles, follows a global path through sub-goals.
 pub fn run_start(
     setup: &TrialSetup,
     method: Method,
@@ -113,6 +115,19 @@ pub fn run_start(
     for t in 0..trials {
         let mut io = setup.robot(start, t)?;
         let d = match method {
+            Method::Learned if !setup.scene.obstacles.is_empty() => {
+                let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
+                deliver_among_obstacles(
+                    &mut io,
+                    &mut strat,
+                    goal,
+                    &scene_obstacles(&setup.scene),
+                    &setup.delivery,
+                    &ObstacleParams::default(),
+                    &mut |_| Ok(()),
+                )?
+                .delivery
+            }
             Method::Learned => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
                 deliver_learned(&mut io, &mut strat, goal, &setup.delivery, &mut |_| Ok(()))?

@@ -8,6 +8,8 @@
 //! - [`regression`]: k-nearest-neighbour kernel regression of Algorithm 2 (§III-E), general
 //!   and special case, on k-d trees.
 //! - [`dipole`]: the dipole field used as the baseline in §V (Fig. 10–11).
+//! - [`obstacles`]: a global path among obstacles followed through sub-goals (§III-E), and
+//!   "collect (or reuse) then deliver" for a scene.
 
 pub mod bench;
 pub mod collect;
@@ -15,6 +17,7 @@ pub mod deliver;
 pub mod dipole;
 pub mod eval;
 pub mod figures;
+pub mod obstacles;
 pub mod regression;
 pub mod robot_io;
 pub mod sample;

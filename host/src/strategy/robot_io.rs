@@ -137,11 +137,16 @@ pub struct SimRobotOptions {
     pub speed: f64,
     /// Spin rate, rad/s.
     pub spin_rate: f64,
-    /// How far inside the scene's table the object's boundary lies, m.
+    /// How far inside the scene's table the object's boundary lies, m. The default, 0.1 m,
+    /// leaves every start position of the Lau presets at least 9 cm inside the boundary (at
+    /// 0.2 m the L-shape's marker at start E lay outside it before the first push).
     pub boundary_inset: f64,
     /// Extra table the simulated world gets beyond the scene's table on every side, m, so the
     /// robot can get behind an object that left the boundary (the paper's table was larger
-    /// than its boundary). Observations stay in the scene's coordinates.
+    /// than its boundary). With the default 0.25 m, an object that overshoots the boundary by
+    /// a push still leaves the robot room to get behind it; with less, a thin object (the
+    /// snake) pushed against the wall could not be pushed back. Observations stay in the
+    /// scene's coordinates.
     pub table_margin: f64,
 }
 
@@ -153,8 +158,8 @@ impl Default for SimRobotOptions {
             heading_noise: 0.5f64.to_radians(),
             speed: 0.12,
             spin_rate: 3.0,
-            boundary_inset: 0.2,
-            table_margin: 0.15,
+            boundary_inset: 0.1,
+            table_margin: 0.25,
         }
     }
 }

@@ -451,13 +451,21 @@ pub const CASES: &[(&str, &str, &str)] = &[
     ("D1", "Fig. 19: rotational pushes in clutter", D1),
 ];
 
-/// Load a preset by name (case-insensitive) or a scene file by path.
+/// Load a preset by name (case-insensitive), a simulator preset with a `[rearrange]` section,
+/// or a scene file by path: the shared scene format (it has a `[table]`; see
+/// [`super::scene`]) or this grid format.
 pub fn load_scene(name_or_path: &str) -> Result<Problem, SceneError> {
     if let Some((n, _, text)) = CASES
         .iter()
         .find(|(n, _, _)| n.eq_ignore_ascii_case(name_or_path))
     {
         return parse_scene(text, n);
+    }
+    if pushbot_sim::scene::PRESETS.contains(&name_or_path) {
+        let scene =
+            pushbot_sim::Scene::preset(name_or_path).map_err(|e| SceneError(e.to_string()))?;
+        return super::scene::problem_from_scene(&scene, None, &format!("preset {name_or_path}"))
+            .map_err(|e| SceneError(e.to_string()));
     }
     let path = std::path::Path::new(name_or_path);
     let text = std::fs::read_to_string(path).map_err(|e| {
@@ -466,8 +474,15 @@ pub fn load_scene(name_or_path: &str) -> Result<Problem, SceneError> {
             CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
         ))
     })?;
+    let file = path.display().to_string();
+    if toml::from_str::<toml::Table>(&text).is_ok_and(|t| t.contains_key("table")) {
+        let scene =
+            pushbot_sim::Scene::from_toml(&text, &file).map_err(|e| SceneError(e.to_string()))?;
+        return super::scene::problem_from_scene(&scene, Some(&text), &file)
+            .map_err(|e| SceneError(e.to_string()));
+    }
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
-    parse_scene(&text, stem).map_err(|e| SceneError(format!("{}: {}", path.display(), e.0)))
+    parse_scene(&text, stem).map_err(|e| SceneError(format!("{file}: {}", e.0)))
 }
 
 macro_rules! a_map {

@@ -7,8 +7,10 @@
 //! - [`metric`]: the cost metrics of §IV-C (mass, safety, passability, contact-mode changes, turns);
 //! - [`costmap`]: the cost mapping phase, §IV-A1 (backward propagation from a goal set);
 //! - [`restore`]: the pushing C-path restoration phase, §IV-A2;
-//! - [`cases`]: the scene format and the test cases A–D of §V-A;
-//! - [`svg`]: plans drawn as the paper's step-by-step figures.
+//! - [`cases`]: the grid scene format and the test cases A–D of §V-A;
+//! - [`scene`]: the shared scene format (`[rearrange]` section) rasterised to a grid problem;
+//! - [`svg`]: plans drawn as the paper's step-by-step figures;
+//! - [`execute`]: plans carried out by the robot on the table, closed on the camera (§V-B).
 //!
 //! Limits (§IV-E): the map holds one `u16` per packed configuration, so memory grows as
 //! (free cells)^(1 + r) — 128 MB for the robot and 2 boxes in a 20 × 20 room, 860 MB for 3 boxes in
@@ -19,9 +21,11 @@
 pub mod admissibility;
 pub mod cases;
 pub mod costmap;
+pub mod execute;
 pub mod metric;
 pub mod problem;
 pub mod restore;
+pub mod scene;
 pub mod svg;
 
 pub use admissibility::{MoveKind, Step};

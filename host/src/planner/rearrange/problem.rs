@@ -471,6 +471,37 @@ pub struct Model {
     pub rot_post: Vec<[Vec<RotInstance>; 4]>,
     /// Largest cost of one move.
     pub max_edge: u32,
+    /// Division by each radix without a divide instruction (decoding is in the hot loop).
+    pub div: Vec<FastDiv>,
+}
+
+/// Division of a `u32` by a fixed divisor as a multiply and a shift (Lemire, Kaser & Kurz,
+/// "Faster remainder by direct computation", 2019): with `m = ⌈2⁶⁴ / d⌉`, `n / d` is the high
+/// 64 bits of `m · n` for every 32-bit `n`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FastDiv {
+    m: u64,
+    d: u32,
+}
+
+impl FastDiv {
+    /// A divider by `d` (≥ 1).
+    pub fn new(d: u32) -> FastDiv {
+        let d = d.max(1);
+        FastDiv {
+            m: if d == 1 { 0 } else { u64::MAX / d as u64 + 1 },
+            d,
+        }
+    }
+    /// `(n / d, n % d)`.
+    #[inline(always)]
+    pub fn div_rem(self, n: u32) -> (u32, u32) {
+        if self.d == 1 {
+            return (n, 0);
+        }
+        let q = ((self.m as u128 * n as u128) >> 64) as u32;
+        (q, n - q * self.d)
+    }
 }
 
 /// A packed configuration, decoded into local indices.
@@ -792,7 +823,7 @@ impl Model {
                 "one move may cost {max_edge}: the metric weights are too large (limit 4000)"
             ));
         }
-        let model = Model {
+        let mut model = Model {
             problem: p.clone(),
             n_aux,
             robot,
@@ -818,7 +849,9 @@ impl Model {
             rot_pre,
             rot_post,
             max_edge,
+            div: Vec::new(),
         };
+        model.div = model.radix.iter().map(|&r| FastDiv::new(r)).collect();
         if model.pack(&p.start).is_none() {
             return invalid(
                 "the start configuration overlaps an obstacle, the grid border or another body",
@@ -860,15 +893,11 @@ impl Model {
         };
         let mut x = idx;
         if self.n_aux > 1 {
-            s.aux = x % self.radix[0];
-            x /= self.radix[0];
+            (x, s.aux) = self.div[0].div_rem(x);
         }
-        s.r = x % self.radix[1];
-        x /= self.radix[1];
+        (x, s.r) = self.div[1].div_rem(x);
         for i in 0..self.r() {
-            let n = self.radix[2 + i];
-            s.m[i] = x % n;
-            x /= n;
+            (x, s.m[i]) = self.div[2 + i].div_rem(x);
         }
         s
     }
@@ -1035,6 +1064,28 @@ impl Model {
                 }
                 digits[k] = 0;
                 k += 1;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FastDiv;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn fast_division_equals_division() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut divisors: Vec<u32> = vec![1, 2, 3, 7, 8, 400, 401, 65_536, u32::MAX - 1, u32::MAX];
+        divisors.extend((0..200).map(|_| rng.random_range(1..=u32::MAX)));
+        divisors.extend((0..200).map(|_| rng.random_range(1..=5000)));
+        for d in divisors {
+            let f = FastDiv::new(d);
+            let mut ns: Vec<u32> = vec![0, 1, d - 1, d, d.wrapping_add(1), u32::MAX, u32::MAX - 1];
+            ns.extend((0..500).map(|_| rng.random::<u32>()));
+            for n in ns {
+                assert_eq!(f.div_rem(n), (n / d, n % d), "{n} / {d}");
             }
         }
     }

@@ -1,0 +1,478 @@
+//! `pushbot demo`: the whole system in one command. It starts the built-in simulated target
+//! (the firmware's own code on a simulated robot, a real pty for its serial port, a camera
+//! socket) — or takes `--port`/`--camera` of a real robot — connects exactly as to hardware, and
+//! runs three stages, each with a progress bar:
+//!
+//! 1. **strategy** (Lau, Mitani & Igarashi): collect a pushing strategy for an irregular object
+//!    (or reuse the cached one), then deliver the object to its goal among obstacles;
+//! 2. **rearrange** (Ben-Shahar & Rivlin): plan an optimal rearrangement of two boxes (cost map
+//!    and restoration) and execute it, re-observing and snapping to the grid;
+//! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and execute
+//!    them open loop.
+//!
+//! It writes a report folder (`report.html`, `summary.json`, figures, `demo.log`) and prints its
+//! path.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use pushbot_sim::Scene;
+
+use super::{CliError, CliResult, Global, Status};
+use crate::exec::record::{Recorder, TracePoint, TruthProbe};
+use crate::exec::{LiveOptions, LiveRobot, SimTarget};
+use crate::report::{Report, StageReport, figure};
+use crate::strategy::sample::Pose2;
+
+/// The stages, in the order they run.
+pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
+
+/// `pushbot demo`.
+#[derive(Args, Debug, Clone)]
+#[command(
+    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml"
+)]
+pub struct DemoArgs {
+    /// Folder for the report (created; files in it are replaced).
+    #[arg(long, default_value = "pushbot-demo")]
+    pub out: PathBuf,
+    /// Stages to run, comma-separated: strategy, rearrange, stable.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "strategy,rearrange,stable"
+    )]
+    pub stages: Vec<String>,
+    /// A stage's scene, `STAGE=PRESET|FILE` (repeatable); defaults: strategy=lau-obstacles,
+    /// rearrange=A1 (two boxes), stable=fig16.
+    #[arg(long = "scene", value_name = "STAGE=SCENE")]
+    pub scenes: Vec<String>,
+    /// The robot's serial port: run on a real robot (needs --camera) instead of the built-in
+    /// simulated target.
+    #[arg(long, requires = "camera")]
+    pub port: Option<String>,
+    /// The overhead camera (/dev/videoN, a folder, sim:HOST:PORT), with --port.
+    #[arg(long, requires = "port")]
+    pub camera: Option<String>,
+    /// Simulated seconds per wall second of the built-in target.
+    #[arg(long, default_value_t = 8.0)]
+    pub speed: f64,
+    /// Also render every figure as PNG.
+    #[arg(long)]
+    pub png: bool,
+    /// Where collected pushing strategies are cached (default: OUT/cache).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+}
+
+/// Everything a stage needs.
+struct Ctx<'a> {
+    args: &'a DemoArgs,
+    g: &'a Global,
+    report: Report,
+    log: std::fs::File,
+}
+
+impl Ctx<'_> {
+    fn log(&mut self, line: &str) {
+        let _ = writeln!(self.log, "{line}");
+        tracing::info!("{line}");
+    }
+
+    fn bar(&self, stage: &str) -> ProgressBar {
+        let pb = if self.g.json {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new_spinner()
+        };
+        pb.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {prefix:10} {wide_msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        pb.set_prefix(stage.to_string());
+        pb.enable_steady_tick(std::time::Duration::from_millis(120));
+        pb
+    }
+
+    /// Run `f` on the robot: the built-in simulated target serving `scene`, or the real one.
+    fn with_robot<T>(
+        &mut self,
+        scene: &Scene,
+        object: Option<&str>,
+        ids: &[String],
+        f: impl FnOnce(&mut Recorder<'_>) -> Result<T>,
+    ) -> Result<(T, Vec<TracePoint>)> {
+        let speed = if self.args.port.is_some() {
+            1.0
+        } else {
+            self.args.speed
+        };
+        let opts = LiveOptions {
+            object: object.map(str::to_owned),
+            watchdog_ms: (1000.0 * speed.max(1.0)).min(5000.0) as u16,
+            ..LiveOptions::default()
+        };
+        match (&self.args.port, &self.args.camera) {
+            (Some(port), Some(camera)) => {
+                let mut live = LiveRobot::connect(port, camera, scene, opts)?;
+                let mut rec = Recorder::new(&mut live, ids, None);
+                let out = f(&mut rec)?;
+                Ok((out, rec.into_trace()))
+            }
+            _ => {
+                let target = SimTarget::start(scene, self.g.seed, speed, None)?;
+                self.log(&format!(
+                    "simulated target: serial {} camera {}",
+                    target.port(),
+                    target.camera()
+                ));
+                let result = {
+                    let mut live = LiveRobot::connect(target.port(), target.camera(), scene, opts)?;
+                    let probe: TruthProbe<'_> = Box::new(|| {
+                        let t = target.sim().truth().pose;
+                        let objects = target
+                            .sim()
+                            .objects()
+                            .into_iter()
+                            .map(|(id, p)| (id, Pose2::new(p.x, p.y, p.theta)))
+                            .collect();
+                        (Pose2::new(t.x, t.y, t.theta), objects)
+                    });
+                    let mut rec = Recorder::new(&mut live, ids, Some(probe));
+                    let out = f(&mut rec);
+                    out.map(|o| (o, rec.into_trace()))
+                };
+                target.shutdown()?;
+                result
+            }
+        }
+    }
+}
+
+/// The scene a stage runs on: `--scene STAGE=…` or the default.
+fn scene_arg<'a>(args: &'a DemoArgs, stage: &str, default: &'a str) -> Result<&'a str, CliError> {
+    for s in &args.scenes {
+        let Some((k, v)) = s.split_once('=') else {
+            return Err(CliError::bad_input(format!(
+                "--scene {s:?}: expected STAGE=SCENE, e.g. strategy=lau-snake"
+            )));
+        };
+        if !STAGES.contains(&k) {
+            return Err(CliError::bad_input(format!(
+                "--scene {s:?}: unknown stage {k:?}; the stages are {}",
+                STAGES.join(", ")
+            )));
+        }
+        if k == stage {
+            return Ok(v);
+        }
+    }
+    Ok(default)
+}
+
+fn load_scene(name: &str) -> Result<Scene, CliError> {
+    Scene::preset_or_file(name).map_err(|e| CliError::bad_input(e.to_string()))
+}
+
+/// Run `pushbot demo`.
+pub fn run(g: &Global, args: DemoArgs) -> CliResult {
+    for s in &args.stages {
+        if !STAGES.contains(&s.as_str()) {
+            return Err(CliError::bad_input(format!(
+                "--stages: unknown stage {s:?}; the stages are {}",
+                STAGES.join(", ")
+            )));
+        }
+    }
+    if !(args.speed.is_finite() && args.speed > 0.0 && args.speed <= 50.0) {
+        return Err(CliError::bad_input(format!(
+            "--speed must be in (0, 50], not {}",
+            args.speed
+        )));
+    }
+    // Check every scene before running anything.
+    let strategy_scene = load_scene(scene_arg(&args, "strategy", "lau-obstacles")?)?;
+    let rearrange_case = scene_arg(&args, "rearrange", "A1")?.to_string();
+    let rearrange_problem = crate::planner::rearrange::cases::load_scene(&rearrange_case)
+        .map_err(|e| CliError::bad_input(e.to_string()))?;
+    let stable_name = scene_arg(&args, "stable", "fig16")?.to_string();
+
+    let report = Report::create(&args.out, "pushbot demo", args.png).map_err(CliError::Failed)?;
+    let log = std::fs::File::create(args.out.join("demo.log"))
+        .map_err(|e| CliError::Failed(anyhow!("creating demo.log: {e}")))?;
+    let mut ctx = Ctx {
+        args: &args,
+        g,
+        report,
+        log,
+    };
+    let t0 = Instant::now();
+    for stage in &args.stages {
+        let started = Instant::now();
+        let result = match stage.as_str() {
+            "strategy" => stage_strategy(&mut ctx, &strategy_scene),
+            "rearrange" => stage_rearrange(&mut ctx, &rearrange_case, &rearrange_problem),
+            _ => stage_stable(&mut ctx, &stable_name),
+        };
+        let mut rep = match result {
+            Ok(r) => r,
+            Err(e) => {
+                let mut r = StageReport::new(stage, stage, "");
+                r.notes.push(format!("error: {e:#}"));
+                r
+            }
+        };
+        rep.wall_s = started.elapsed().as_secs_f64();
+        ctx.log(&format!(
+            "stage {stage}: {} in {:.1} s wall, {:.1} s robot",
+            if rep.success { "reached" } else { "FAILED" },
+            rep.wall_s,
+            rep.robot_s
+        ));
+        for n in &rep.notes {
+            ctx.log(&format!("  {n}"));
+        }
+        ctx.report.add(rep);
+    }
+    let page = ctx.report.write().map_err(CliError::Failed)?;
+    let ok = ctx.report.success();
+    if g.json {
+        let v = serde_json::json!({
+            "report": page,
+            "success": ok,
+            "wall_s": t0.elapsed().as_secs_f64(),
+            "stages": ctx.report.stages(),
+        });
+        println!("{v}");
+    } else {
+        for s in ctx.report.stages() {
+            println!(
+                "{:10} {:8} {:6.1} s",
+                s.id,
+                if s.success { "reached" } else { "FAILED" },
+                s.wall_s
+            );
+        }
+        println!("report: {}", page.display());
+    }
+    Ok(if ok {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
+}
+
+/// Lau et al.: collect (or reuse) the strategy, deliver among obstacles through the link.
+fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
+    use crate::strategy::collect::CollectParams;
+    use crate::strategy::deliver::DeliveryParams;
+    use crate::strategy::figures::strategy_svg;
+    use crate::strategy::obstacles::{
+        ObstacleParams, collect_or_load, deliver_among_obstacles, scene_goal, scene_obstacles,
+    };
+    use crate::strategy::regression::{KernelParams, PushStrategy};
+    use crate::strategy::robot_io::SimRobotOptions;
+
+    let mut st = StageReport::new(
+        "strategy",
+        "Learned pushing strategy: deliver an irregular object among obstacles",
+        "Lau, Mitani & Igarashi §III-C–E (Algorithms 1, 2)",
+    );
+    let object = scene
+        .objects
+        .first()
+        .ok_or_else(|| anyhow!("scene {} has no object", scene.name))?
+        .clone();
+    let cache_dir = ctx
+        .args
+        .cache
+        .clone()
+        .unwrap_or_else(|| ctx.args.out.join("cache"));
+    std::fs::create_dir_all(&cache_dir)
+        .with_context(|| format!("creating {}", cache_dir.display()))?;
+    let cache = cache_dir.join(format!("{}-{}.strategy", scene.name, object.id));
+    let pb = ctx.bar("strategy");
+    pb.set_message(format!(
+        "pushing strategy for {} ({})",
+        object.id,
+        cache.display()
+    ));
+    let kernel = KernelParams::default();
+    let sim = SimRobotOptions {
+        seed: ctx.g.seed,
+        ..SimRobotOptions::default()
+    };
+    let (samples, collection) = collect_or_load(
+        scene,
+        Some(&object.id),
+        &cache,
+        sim,
+        &CollectParams::default(),
+        kernel,
+        &pb,
+    )?;
+    st.number("samples", samples.len());
+    st.number("collected_now", collection.is_some());
+    if let Some(c) = &collection {
+        st.number("collection", serde_json::to_value(c)?);
+    }
+    let marker = object.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+    let outline: Vec<[f64; 2]> = object
+        .outline
+        .iter()
+        .map(|v| [v[0] - marker[0], v[1] - marker[1]])
+        .collect();
+    let f = ctx
+        .report
+        .figure("strategy-samples", &strategy_svg(&samples, &outline))?;
+    st.figures.push((
+        f,
+        format!(
+            "The pushing strategy of {} (Fig. 7): each sample's robot motion from where it pushed, and the object's motion",
+            object.id
+        ),
+    ));
+    pb.set_message("delivering through the serial port and the camera");
+    let goal = scene_goal(scene, Some(&object.id))?;
+    let obstacles = scene_obstacles(scene);
+    let ids = vec![object.id.clone()];
+    let (res, trace) = ctx.with_robot(scene, Some(&object.id), &ids, |io| {
+        let mut strategy = PushStrategy::new(samples.iter().copied(), kernel);
+        deliver_among_obstacles(
+            io,
+            &mut strategy,
+            goal,
+            &obstacles,
+            &DeliveryParams::default(),
+            &ObstacleParams::default(),
+            &mut |_| Ok(()),
+        )
+    })?;
+    pb.finish_and_clear();
+    let d = &res.delivery;
+    st.success = d.success;
+    st.robot_s = d.time;
+    st.number("steps", d.steps);
+    st.number("repositions", d.repositions);
+    st.number("subgoals", res.subgoals.len());
+    st.number("final_distance_m (camera)", d.final_distance);
+    if let Some(last) = trace.last().and_then(|p| p.truth.clone()) {
+        let m = scene_marker_truth(&object, &last.1);
+        if let Some(m) = m {
+            st.number(
+                "final_distance_m (truth)",
+                (m[0] - goal.x).hypot(m[1] - goal.y),
+            );
+        }
+    }
+    if let Some(why) = &d.failure {
+        st.notes.push(format!("delivery failed: {why:?}"));
+    }
+    st.notes.push(format!(
+        "{} samples ({}); delivered in {} pushes, {:.0} s of robot time",
+        samples.len(),
+        if collection.is_some() {
+            "collected now"
+        } else {
+            "from the cache"
+        },
+        d.steps,
+        d.time
+    ));
+    let f = ctx.report.figure(
+        "strategy-delivery",
+        &figure::run_svg(scene, &trace, "delivery among obstacles (truth)", true),
+    )?;
+    st.figures.push((
+        f,
+        "Delivery (Fig. 8): robot blue, object red, start dashed, goal green".into(),
+    ));
+    Ok(st)
+}
+
+/// Where the object's marker truly is, from its true body pose.
+fn scene_marker_truth(
+    object: &pushbot_sim::scene::Object,
+    truth: &[(String, Pose2)],
+) -> Option<[f64; 2]> {
+    let (_, p) = truth.iter().find(|(id, _)| *id == object.id)?;
+    let m = object.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+    let (s, c) = p.theta.sin_cos();
+    Some([p.x + c * m[0] - s * m[1], p.y + s * m[0] + c * m[1]])
+}
+
+/// Ben-Shahar & Rivlin: cost map, restoration, execution through the link with snapping.
+fn stage_rearrange(
+    ctx: &mut Ctx<'_>,
+    case: &str,
+    problem: &crate::planner::rearrange::Problem,
+) -> Result<StageReport> {
+    use crate::planner::rearrange::execute::{ExecOptions, SceneOptions, execute, scene_for};
+    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg};
+
+    let mut st = StageReport::new(
+        "rearrange",
+        &format!("Optimal rearrangement of {case} by pushing"),
+        "Ben-Shahar & Rivlin §IV (cost map, restoration), §V",
+    );
+    let pb = ctx.bar("rearrange");
+    pb.set_message("cost map");
+    let model = Model::new(problem).map_err(|e| anyhow!("{e}"))?;
+    let map = cost_map(&model).map_err(|e| anyhow!("{e}"))?;
+    st.number("states_mapped", map.stats.states_mapped);
+    st.number("map_ms", map.stats.map_ms);
+    let start = model
+        .pack(&problem.start)
+        .ok_or_else(|| anyhow!("the start of {case} is not free"))?;
+    let plan = restore(&model, &map, start).map_err(|e| anyhow!("{e}"))?;
+    st.number("plan_cost", plan.cost);
+    st.number("plan_steps", plan.steps.len());
+    let f = ctx
+        .report
+        .figure("rearrange-plan", &plan_svg(&model, &plan))?;
+    st.figures
+        .push((f, format!("The optimal plan of {case}, step by step")));
+    let scene_opts = SceneOptions::default();
+    let scene = scene_for(problem, &scene_opts)?;
+    let ids: Vec<String> = scene.objects.iter().map(|o| o.id.clone()).collect();
+    pb.set_message("executing through the serial port and the camera");
+    let exec = ExecOptions {
+        cell: scene_opts.cell,
+        fill: scene_opts.fill,
+        ..ExecOptions::default()
+    };
+    let (rep, trace) = ctx.with_robot(&scene, None, &ids, |io| execute(&model, &map, io, &exec))?;
+    pb.finish_and_clear();
+    st.success = rep.reached;
+    st.robot_s = rep.time_s;
+    st.number("executed_cost", rep.executed_cost);
+    st.number("pushes", rep.pushes);
+    st.number("deviations_snapped", rep.deviations);
+    let f = ctx.report.figure(
+        "rearrange-run",
+        &figure::run_svg(&scene, &trace, "executed rearrangement (truth)", true),
+    )?;
+    st.figures.push((
+        f,
+        "Execution on the simulated target: robot blue, boxes red".into(),
+    ));
+    Ok(st)
+}
+
+/// Lynch & Mason: plan stable pushes, execute open loop.
+fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
+    let st = StageReport::new(
+        "stable",
+        &format!("Stable pushing of the slider ({name})"),
+        "Lynch & Mason §3–4",
+    );
+    let _ = (ctx, Path::new(name));
+    Err(anyhow!(
+        "the stable-pushing stage is not wired yet ({})",
+        st.title
+    ))
+}

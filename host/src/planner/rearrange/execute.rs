@@ -1,0 +1,531 @@
+//! Executing a rearrangement plan on the robot, Ben-Shahar & Rivlin §V-B (the NOMAD-200
+//! experiment): the grid plan becomes motion primitives on the real table, and the camera
+//! closes the loop.
+//!
+//! The grid lies on the table with its row 0 along the far edge ([`GridFrame`]: cell `(x, y)`
+//! has its centre at `((x + ½)·c, (h − y − ½)·c)` metres, table y pointing up, so the map reads
+//! as the table seen from above). A movable is a body whose frame sits at the centre of its
+//! anchor cell and turns with it (orientation `o` quarter turns clockwise is heading `−o·π/2`);
+//! [`scene_for`] builds a simulator scene for a grid problem in exactly these terms.
+//!
+//! [`execute`] repeats: observe → snap to the grid → restore the plan from the map (§IV-A2) →
+//! carry out its first *segment*, the longest run of moves in one direction of one kind (a
+//! transit drive, or a push run that ends by backing off the movable to the cell centre). The
+//! map is never recomputed: when a movable ends off its expected cell, the snapped configuration
+//! is simply a new start for restoration, which costs no re-propagation.
+
+use std::f64::consts::FRAC_PI_2;
+
+use anyhow::{Context, Result, anyhow, bail};
+use nalgebra::Vector2;
+
+use super::admissibility::MoveKind;
+use super::costmap::CostMap;
+use super::problem::{Config, Dir, Model, Placement, Problem};
+use super::restore::restore;
+use crate::strategy::robot_io::RobotIo;
+use crate::strategy::sample::{Pose2, wrap_angle};
+
+/// Where the grid lies on the table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridFrame {
+    /// Side of a cell, m.
+    pub cell: f64,
+    /// Grid height in cells (row 0 is at table y = `h · cell`).
+    pub h: i32,
+}
+
+impl GridFrame {
+    /// The centre of cell `(x, y)`, table frame.
+    pub fn centre(&self, x: i32, y: i32) -> Vector2<f64> {
+        Vector2::new(
+            (x as f64 + 0.5) * self.cell,
+            (self.h as f64 - y as f64 - 0.5) * self.cell,
+        )
+    }
+    /// The cell containing a table point (may lie outside the grid).
+    pub fn cell_of(&self, p: Vector2<f64>) -> (i32, i32) {
+        (
+            (p.x / self.cell).floor() as i32,
+            (self.h as f64 - p.y / self.cell).floor() as i32,
+        )
+    }
+    /// A grid direction as a table unit vector.
+    pub fn dir(d: Dir) -> Vector2<f64> {
+        match d {
+            Dir::E => Vector2::new(1.0, 0.0),
+            Dir::S => Vector2::new(0.0, -1.0),
+            Dir::W => Vector2::new(-1.0, 0.0),
+            Dir::N => Vector2::new(0.0, 1.0),
+        }
+    }
+    /// A grid direction as a heading, rad.
+    pub fn heading(d: Dir) -> f64 {
+        let v = Self::dir(d);
+        v.y.atan2(v.x)
+    }
+    /// The centre of a `k × k` robot block with its anchor (top-left cell) at `a`.
+    pub fn robot_centre(&self, a: (i32, i32), k: i32) -> Vector2<f64> {
+        let half = (k - 1) as f64 / 2.0 * self.cell;
+        self.centre(a.0, a.1) + Vector2::new(half, -half)
+    }
+    /// The body pose of a movable placed at `p`.
+    pub fn body_pose(&self, p: Placement) -> Pose2 {
+        let c = self.centre(p.x, p.y);
+        Pose2::new(c.x, c.y, wrap_angle(-(p.o as f64) * FRAC_PI_2))
+    }
+}
+
+/// How a grid problem becomes a simulator scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneOptions {
+    /// Side of a cell, m.
+    pub cell: f64,
+    /// Fraction of its cells a movable's body fills (the rest is clearance on every side).
+    pub fill: f64,
+    /// Mass of one mass unit of the grid problem, kg.
+    pub kg_per_mass: f64,
+    /// Object–table friction coefficient.
+    pub support_friction: f64,
+    /// Robot–object friction coefficient.
+    pub pusher_friction: f64,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        SceneOptions {
+            cell: 0.1,
+            fill: 0.8,
+            kg_per_mass: 0.2,
+            support_friction: 0.35,
+            pusher_friction: 0.5,
+        }
+    }
+}
+
+/// The body-frame outline of a rectangular movable (cells `(0..w) × (0..h)` from its anchor),
+/// shrunk by `margin` on every side; `None` if the shape is not a full rectangle at the anchor.
+fn rect_outline(cells: &[(i32, i32)], cell: f64, margin: f64) -> Option<Vec<[f64; 2]>> {
+    let (w, h) = (
+        cells.iter().map(|c| c.0).max()? + 1,
+        cells.iter().map(|c| c.1).max()? + 1,
+    );
+    let full = cells.iter().all(|&(x, y)| x >= 0 && y >= 0)
+        && cells.len() == (w * h) as usize
+        && (0..h).all(|y| (0..w).all(|x| cells.contains(&(x, y))));
+    if !full {
+        return None;
+    }
+    let (x0, x1) = (-0.5 * cell + margin, (w as f64 - 0.5) * cell - margin);
+    // Grid y grows down, table y up.
+    let (y0, y1) = (-(h as f64 - 0.5) * cell + margin, 0.5 * cell - margin);
+    Some(vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+}
+
+/// A simulator scene for a grid problem: the table is the grid, obstacle cells are square
+/// obstacles (merged along rows), rectangular movables are boxes at their start with their
+/// goals, the robot starts at the centre of its block facing its start heading. Only
+/// rectangular movables can be built.
+pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::Scene> {
+    use pushbot_sim::scene::{Goal, Marker, Object, Obstacle, RobotSpec, Support, Table};
+    let c = opts.cell;
+    if !(c.is_finite() && c > 0.0 && opts.fill > 0.0 && opts.fill <= 1.0) {
+        bail!("cell must be positive and fill in (0, 1]");
+    }
+    let g = &problem.grid;
+    let frame = GridFrame { cell: c, h: g.h };
+    let robot = RobotSpec::default();
+    let mut obstacles = Vec::new();
+    for y in 0..g.h {
+        let mut x = 0;
+        while x < g.w {
+            if g.get(x, y).is_some_and(|cell| cell.obstacle) {
+                let x0 = x;
+                while g.get(x, y).is_some_and(|cell| cell.obstacle) {
+                    x += 1;
+                }
+                let (ax, bx) = (x0 as f64 * c, x as f64 * c);
+                let (ay, by) = ((g.h - y - 1) as f64 * c, (g.h - y) as f64 * c);
+                obstacles.push(Obstacle {
+                    outline: vec![[ax, ay], [bx, ay], [bx, by], [ax, by]],
+                });
+            } else {
+                x += 1;
+            }
+        }
+    }
+    let margin = (1.0 - opts.fill) / 2.0 * c;
+    let mut objects = Vec::new();
+    let mut goals = Vec::new();
+    for (i, m) in problem.movables.iter().enumerate() {
+        let outline = rect_outline(&m.cells, c, margin).ok_or_else(|| {
+            anyhow!(
+                "movable `{}`: only rectangular movables can be built as simulator boxes",
+                m.name
+            )
+        })?;
+        let side = outline[1][0] - outline[0][0];
+        let p = problem.start.movables[i];
+        let pose = frame.body_pose(p);
+        objects.push(Object {
+            id: m.name.clone(),
+            outline,
+            pose: pushbot_sim::Pose::new(pose.x, pose.y, pose.theta),
+            mass: opts.kg_per_mass * m.mass.max(1) as f64,
+            support: Support::Uniform,
+            support_friction: opts.support_friction,
+            pusher_friction: opts.pusher_friction,
+            marker: Some(Marker {
+                id: 10 + i as u32,
+                x: 0.0,
+                y: 0.0,
+                size: (0.7 * side).min(0.05),
+            }),
+        });
+        if let Some(gp) = problem.goal_movables[i] {
+            let gpose = frame.body_pose(gp);
+            goals.push(Goal {
+                object: m.name.clone(),
+                pose: pushbot_sim::Pose::new(gpose.x, gpose.y, gpose.theta),
+                tolerance: 0.25 * c,
+                angle_tolerance: None,
+                marker: None,
+            });
+        }
+    }
+    let rc = frame.robot_centre(problem.start.robot, problem.robot.size);
+    let scene = pushbot_sim::Scene {
+        name: problem.name.clone(),
+        table: Table {
+            width: g.w as f64 * c,
+            height: g.h as f64 * c,
+        },
+        robot: RobotSpec {
+            start: pushbot_sim::Pose::new(rc.x, rc.y, GridFrame::heading(problem.start.heading)),
+            ..robot
+        },
+        obstacles,
+        objects,
+        goals,
+        positions: Vec::new(),
+        camera: pushbot_sim::scene::CameraSpec::default(),
+        rearrange: Some(super::scene::rearrange_section(
+            problem,
+            c,
+            opts.kg_per_mass,
+        )),
+    };
+    // Round-trip through the checked loader so the scene is one the simulator accepts.
+    pushbot_sim::Scene::from_toml(&scene.to_toml(), &format!("grid scene {}", problem.name))
+        .map_err(|e| anyhow!("{e}"))
+}
+
+/// Settings of the executor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExecOptions {
+    /// Side of a cell, m.
+    pub cell: f64,
+    /// Fraction of its cells a movable's body fills (as in [`SceneOptions::fill`]).
+    pub fill: f64,
+    /// Most segments before giving up.
+    pub max_segments: usize,
+    /// Longest push run between two observations, cells (a point pusher lets a box turn
+    /// slowly; short runs re-align it).
+    pub max_push_cells: usize,
+    /// Give up when the same configuration is observed this many times.
+    pub max_repeats: usize,
+}
+
+impl Default for ExecOptions {
+    fn default() -> Self {
+        ExecOptions {
+            cell: 0.1,
+            fill: 0.8,
+            max_segments: 400,
+            max_push_cells: 2,
+            max_repeats: 6,
+        }
+    }
+}
+
+/// How an execution went.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ExecReport {
+    /// The goal set was reached (the observed configuration has cost 0).
+    pub reached: bool,
+    /// Segments carried out (transit drives and push runs).
+    pub segments: usize,
+    /// Grid moves carried out.
+    pub moves: usize,
+    /// Pushing moves among them.
+    pub pushes: usize,
+    /// Times the observed configuration differed from the expected one (and restoration
+    /// started from the observed one instead).
+    pub deviations: usize,
+    /// Cost of the plan from the first observation.
+    pub planned_cost: u32,
+    /// Cost of the moves actually carried out.
+    pub executed_cost: u32,
+    /// Robot time spent, s.
+    pub time_s: f64,
+    /// The last observed configuration: robot anchor and movables' (x, y, o).
+    pub final_robot: (i32, i32),
+    /// The movables' last observed placements.
+    pub final_movables: Vec<(i32, i32, u8)>,
+}
+
+/// Observe the robot and every movable and snap them to the grid. `memory` is the robot's last
+/// move (direction, was a push), which the camera cannot see.
+pub fn observe(
+    model: &Model,
+    frame: &GridFrame,
+    io: &mut dyn RobotIo,
+    memory: (Dir, bool),
+) -> Result<Config> {
+    let p = &model.problem;
+    let k = p.robot.size;
+    let rp = io.robot_pose();
+    let half = (k - 1) as f64 / 2.0 * frame.cell;
+    let anchor = frame.cell_of(rp.position() - Vector2::new(half, -half));
+    let mut movables = Vec::with_capacity(p.movables.len());
+    for (i, m) in p.movables.iter().enumerate() {
+        let bp = io
+            .body_pose(&m.name)
+            .ok_or_else(|| anyhow!("the camera does not see movable `{}`", m.name))?;
+        let (x, y) = frame.cell_of(bp.position());
+        let o = if m.rotates {
+            ((-bp.theta / FRAC_PI_2).round() as i32).rem_euclid(4) as u8
+        } else {
+            p.start.movables[i].o
+        };
+        movables.push(Placement { x, y, o });
+    }
+    Ok(Config {
+        robot: anchor,
+        heading: memory.0,
+        pushing: memory.1,
+        movables,
+    })
+}
+
+/// When the snapped configuration overlaps (the robot was seen across a cell border from
+/// where it stands clear), put the robot on the nearest cell around it that is free.
+fn snap_free(model: &Model, frame: &GridFrame, io: &mut dyn RobotIo, q: Config) -> Config {
+    if model.pack(&q).is_some() {
+        return q;
+    }
+    let k = model.problem.robot.size;
+    let rp = io.robot_pose().position();
+    let mut options: Vec<(f64, (i32, i32))> = Vec::new();
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let a = (q.robot.0 + dx, q.robot.1 + dy);
+            options.push(((frame.robot_centre(a, k) - rp).norm(), a));
+        }
+    }
+    options.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, a) in options {
+        let c = Config {
+            robot: a,
+            ..q.clone()
+        };
+        if model.pack(&c).is_some() {
+            return c;
+        }
+    }
+    q
+}
+
+/// Turn to `heading` (rad) from the observed pose.
+fn face(io: &mut dyn RobotIo, heading: f64) -> Result<()> {
+    let now = io.robot_pose().theta;
+    io.spin(wrap_angle(heading - now))
+}
+
+/// Drive the robot's centre to `target` (turn, then straight).
+fn drive_to(io: &mut dyn RobotIo, target: Vector2<f64>) -> Result<()> {
+    let p = io.robot_pose();
+    let d = target - p.position();
+    if d.norm() < 0.003 {
+        return Ok(());
+    }
+    face(io, d.y.atan2(d.x))?;
+    // Re-measure after the turn: spinning in place may have shifted the centre a little.
+    let p = io.robot_pose();
+    io.forward((target - p.position()).norm())
+}
+
+/// Carry out the plan from the map until the goal set is reached, re-observing after every
+/// segment and restoring from the observed configuration (never recomputing the map).
+pub fn execute(
+    model: &Model,
+    map: &CostMap,
+    io: &mut dyn RobotIo,
+    opts: &ExecOptions,
+) -> Result<ExecReport> {
+    let p = &model.problem;
+    let frame = GridFrame {
+        cell: opts.cell,
+        h: p.grid.h,
+    };
+    let k = p.robot.size;
+    let r = io.workspace().robot_radius;
+    let margin = (1.0 - opts.fill) / 2.0 * opts.cell;
+    // Robot centre ahead of its cell(s) centre when its bumper touches a movable's face.
+    let contact_ahead = k as f64 * opts.cell / 2.0 + margin - r;
+    let t0 = io.time();
+    let mut memory = (p.start.heading, p.start.pushing);
+    let mut expected: Option<Config> = None;
+    let mut seen: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    let mut report = ExecReport {
+        reached: false,
+        segments: 0,
+        moves: 0,
+        pushes: 0,
+        deviations: 0,
+        planned_cost: 0,
+        executed_cost: 0,
+        time_s: 0.0,
+        final_robot: (0, 0),
+        final_movables: Vec::new(),
+    };
+    loop {
+        let q = observe(model, &frame, io, memory)?;
+        report.final_robot = q.robot;
+        report.final_movables = q.movables.iter().map(|m| (m.x, m.y, m.o)).collect();
+        if let Some(e) = &expected
+            && (e.robot != q.robot || e.movables != q.movables)
+        {
+            report.deviations += 1;
+            tracing::info!(
+                "observed {:?} {:?}, expected {:?} {:?}: restoring from the observation",
+                q.robot,
+                q.movables,
+                e.robot,
+                e.movables
+            );
+        }
+        let q = snap_free(model, &frame, io, q);
+        let idx = model.pack(&q).ok_or_else(|| {
+            anyhow!(
+                "the observed configuration (robot {:?}, movables {:?}) is not free on the grid",
+                q.robot,
+                q.movables
+            )
+        })?;
+        let cost = map
+            .get(idx)
+            .ok_or_else(|| anyhow!("no pushing path exists from the observed configuration"))?;
+        if report.segments == 0 {
+            report.planned_cost = cost;
+        }
+        if cost == 0 {
+            report.reached = true;
+            break;
+        }
+        let repeats = seen.entry(idx).or_insert(0);
+        *repeats += 1;
+        if *repeats > opts.max_repeats {
+            let n = *repeats;
+            let seen_at: Vec<String> = std::iter::once(("robot", Some(io.robot_pose())))
+                .chain(
+                    p.movables
+                        .iter()
+                        .map(|m| (m.name.as_str(), io.body_pose(&m.name))),
+                )
+                .map(|(name, pose)| match pose {
+                    Some(b) => format!("{name} at ({:.3}, {:.3}, {:.2} rad)", b.x, b.y, b.theta),
+                    None => format!("{name} not seen"),
+                })
+                .collect();
+            bail!(
+                "no progress: configuration (robot {:?}, movables {:?}) observed {n} times; {}",
+                q.robot,
+                q.movables,
+                seen_at.join(", ")
+            );
+        }
+        if report.segments >= opts.max_segments {
+            break;
+        }
+        let plan = restore(model, map, idx).context("restoring the plan")?;
+        let first = &plan.steps[0].step;
+        let same = |s: &super::admissibility::Step| s.dir == first.dir && s.kind == first.kind;
+        let mut n = plan.steps.iter().take_while(|s| same(&s.step)).count();
+        if let MoveKind::Push { .. } = first.kind {
+            n = n.min(opts.max_push_cells.max(1));
+        }
+        let seg = &plan.steps[..n];
+        let last = &seg[n - 1].config;
+        let end = frame.robot_centre(last.robot, k);
+        tracing::debug!(
+            "segment {:?} {:?} × {n}: robot {:?} → {:?}, movables {:?} → {:?}",
+            first.kind,
+            first.dir,
+            q.robot,
+            last.robot,
+            q.movables,
+            last.movables
+        );
+        match first.kind {
+            MoveKind::Transit => drive_to(io, end)?,
+            MoveKind::Push { pushed } => {
+                let u = GridFrame::dir(first.dir);
+                let perp = Vector2::new(-u.y, u.x);
+                // Stand on the line of the nearest pushed movable as it really lies, so the
+                // bumper meets its face where the grid says.
+                let here = io.robot_pose().position();
+                let mut lead = None;
+                let mut nearest = f64::INFINITY;
+                for (i, m) in p.movables.iter().enumerate() {
+                    if pushed & (1 << i) == 0 {
+                        continue;
+                    }
+                    if let Some(bp) = io.body_pose(&m.name) {
+                        let d = (bp.position() - here).norm();
+                        if d < nearest {
+                            nearest = d;
+                            lead = Some(i);
+                        }
+                    }
+                }
+                let lateral = match lead.and_then(|i| io.body_pose(&p.movables[i].name)) {
+                    Some(bp) => {
+                        let at = q.movables[lead.unwrap_or(0)];
+                        (bp.position() - frame.centre(at.x, at.y)).dot(&perp)
+                    }
+                    None => 0.0,
+                };
+                let start = frame.robot_centre(q.robot, k) + perp * lateral;
+                drive_to(io, start)?;
+                face(io, GridFrame::heading(first.dir))?;
+                let target = end + perp * lateral + u * contact_ahead;
+                let along = (target - io.robot_pose().position()).dot(&u);
+                io.forward(along)?;
+                // Back off to the cell centre, or a cell's worth behind the lead movable if it
+                // came up short, so the next move starts clear of it.
+                let rp = io.robot_pose().position();
+                let mut back = (end - rp).dot(&u);
+                if let Some(i) = lead
+                    && let Some(bp) = io.body_pose(&p.movables[i].name)
+                {
+                    let pe = last.movables[i];
+                    let gap = (frame.centre(pe.x, pe.y) - end).dot(&u);
+                    back = back.min((bp.position() - rp).dot(&u) - gap);
+                }
+                io.forward(back.min(0.0))?;
+                report.pushes += n;
+            }
+            MoveKind::Rotate { .. } => {
+                bail!("rotational pushes are not executed yet (only translational plans)")
+            }
+        }
+        report.segments += 1;
+        report.moves += n;
+        report.executed_cost += seg.iter().map(|s| s.step.cost).sum::<u32>();
+        memory = (first.dir, !matches!(first.kind, MoveKind::Transit));
+        expected = Some(last.clone());
+    }
+    report.time_s = io.time() - t0;
+    Ok(report)
+}
