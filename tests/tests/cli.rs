@@ -83,9 +83,13 @@ fn every_command_help_ends_with_an_example_of_itself() {
         args.push("--help");
         let r = pushbot_tests::run_bin("pushbot", &args);
         assert_eq!(r.code, Some(0), "{args:?}: {r:?}");
-        let (_, example) = r.stdout.split_once("\nExample:\n").unwrap_or_else(|| {
-            panic!("`pushbot {}` has no example:\n{}", path.join(" "), r.stdout)
-        });
+        let (_, example) = r
+            .stdout
+            .split_once("\nExample:\n")
+            .or_else(|| r.stdout.split_once("\nExamples:\n"))
+            .unwrap_or_else(|| {
+                panic!("`pushbot {}` has no example:\n{}", path.join(" "), r.stdout)
+            });
         let first = example.lines().next().unwrap_or_default().trim();
         let want = ["pushbot".to_owned()]
             .into_iter()
