@@ -12,7 +12,7 @@ use serde::Serialize;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Parser;
 use pushbot_sim::faults::LinkFaults;
 use pushbot_sim::pushing::Slider;
@@ -142,7 +142,31 @@ enum Sub {
     },
 }
 
+/// Input the simulator refuses (flags, scene files, pusher files, a start off the table):
+/// exit code 2, as `pushbot` gives; anything that fails later exits 1.
+#[derive(Debug)]
+struct BadInput(String);
+
+impl std::fmt::Display for BadInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BadInput {}
+
+/// `bail!` for bad input.
+macro_rules! bad_input {
+    ($($t:tt)*) => {
+        return Err(BadInput(format!($($t)*)).into())
+    };
+}
+
 fn main() {
+    // The Rust runtime ignores SIGPIPE, so `println!` into a closed pipe would panic; with the
+    // default back, `pushbot-sim presets | head -1` ends quietly. The camera socket is written
+    // with MSG_NOSIGNAL by std and the pty gives EIO, so neither can raise the signal.
+    sigpipe::reset();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Sub::Replay {
@@ -162,18 +186,20 @@ fn main() {
     };
     if let Err(e) = result {
         eprintln!("pushbot-sim: {e:#}");
-        std::process::exit(1);
+        let bad = e.downcast_ref::<BadInput>().is_some()
+            || e.downcast_ref::<pushbot_sim::scene::SceneError>().is_some();
+        std::process::exit(if bad { 2 } else { 1 });
     }
 }
 
 fn run(cli: Cli) -> Result<()> {
     let [width, height] = cli.table[..] else {
-        bail!("--table takes a width and a height");
+        bad_input!("--table takes a width and a height");
     };
     let start = match cli.start.as_deref() {
         None => Pose::new(width / 2.0, height / 2.0, 0.0),
         Some(&[x, y, deg]) => Pose::new(x, y, deg.to_radians()),
-        Some(_) => bail!("--start takes x, y and a heading"),
+        Some(_) => bad_input!("--start takes x, y and a heading"),
     };
     let scene = match &cli.scene {
         Some(s) => Some(Scene::preset_or_file(s)?),
@@ -189,14 +215,14 @@ fn run(cli: Cli) -> Result<()> {
             match p {
                 None => Ok(default),
                 Some(p) if (0.0..=1.0).contains(&p) => Ok(p),
-                Some(p) => bail!("--{name} must be a probability in 0..=1, not {p}"),
+                Some(p) => bad_input!("--{name} must be a probability in 0..=1, not {p}"),
             }
         };
         let dur = |name: &str, s: Option<f64>, scale: f64, default: u64| -> Result<u64> {
             match s {
                 None => Ok(default),
                 Some(s) if s.is_finite() && s >= 0.0 && s * scale < 1e15 => Ok((s * scale) as u64),
-                Some(s) => bail!("--{name} must be a duration ≥ 0, not {s}"),
+                Some(s) => bad_input!("--{name} must be a duration ≥ 0, not {s}"),
             }
         };
         f.drop = prob("fault-drop", cli.fault_drop, f.drop)?;
@@ -223,7 +249,8 @@ fn run(cli: Cli) -> Result<()> {
         }),
         ..SimOptions::default()
     };
-    let sim = PtySim::start(opts.clone())?;
+    // Before anything runs, a refusal is of the options given.
+    let sim = PtySim::start(opts.clone()).map_err(|e| BadInput(format!("{e:#}")))?;
     let first = FirstLine {
         serial: sim.serial_path(),
         seed: opts.seed,
@@ -312,7 +339,7 @@ fn replay(scene: &str, object: &str, pusher: &std::path::Path, json: bool) -> Re
             }
             // A header on the first line.
             None if samples.is_empty() && i == 0 => {}
-            _ => bail!(
+            _ => bad_input!(
                 "{}:{}: expected 4 numbers: time s, x m, y m, theta rad",
                 pusher.display(),
                 i + 1
@@ -320,14 +347,14 @@ fn replay(scene: &str, object: &str, pusher: &std::path::Path, json: bool) -> Re
         }
     }
     if samples.is_empty() {
-        bail!("{}: no samples", pusher.display());
+        bad_input!("{}: no samples", pusher.display());
     }
     if samples.windows(2).any(|w| w[1][0] < w[0][0]) {
-        bail!("{}: time must not decrease", pusher.display());
+        bad_input!("{}: time must not decrease", pusher.display());
     }
     let first = samples[0];
     if slider.gap([first[1], first[2]], radius) < -1e-9 {
-        bail!("the pusher starts inside object {object:?}");
+        bad_input!("the pusher starts inside object {object:?}");
     }
     let mut rows = Vec::with_capacity(samples.len());
     let mut prev = first;
@@ -372,7 +399,7 @@ fn replay(scene: &str, object: &str, pusher: &std::path::Path, json: bool) -> Re
 fn bench(scene: &str, seconds: f64) -> Result<()> {
     use pushbot_protocol::{Command, HostFrame, MAX_FRAME, PROTOCOL_VERSION, encode_frame};
     if !(seconds.is_finite() && seconds > 0.0) {
-        bail!("--seconds must be positive");
+        bad_input!("--seconds must be positive");
     }
     let scene = Scene::preset_or_file(scene)?;
     let objects = scene.objects.len();

@@ -306,6 +306,23 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// The key of the value that starts at byte `offset` (`mass` in `mass = "heavy"`, `x` in
+/// `pose = { x = "a" }`), for parse errors whose span is a value.
+fn key_before(text: &str, offset: usize) -> Option<String> {
+    let before = text.get(..offset)?;
+    let line = before.rsplit('\n').next()?;
+    let lhs = line.trim_end().strip_suffix('=')?.trim_end();
+    let key: String = lhs
+        .chars()
+        .rev()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .collect();
+    (!key.is_empty()).then_some(key)
+}
+
 /// The span of the value at `path` in the document, or of its nearest existing ancestor.
 fn span_of(text: &str, path: &[Seg]) -> Option<std::ops::Range<usize>> {
     use toml::de::{DeTable, DeValue};
@@ -361,7 +378,7 @@ impl Scene {
                 file: file.to_owned(),
                 line,
                 column,
-                field: None,
+                field: e.span().and_then(|s| key_before(text, s.start)),
                 message: e.message().trim().to_owned(),
             }
         })?;
@@ -392,7 +409,11 @@ impl Scene {
             line: None,
             column: None,
             field: None,
-            message: format!("cannot read: {e}"),
+            message: if e.kind() == std::io::ErrorKind::InvalidData {
+                "cannot read: not a text (TOML) file".to_owned()
+            } else {
+                format!("cannot read: {e}")
+            },
         })?;
         Scene::from_toml(&text, &file)
     }
@@ -413,10 +434,30 @@ impl Scene {
 
     /// A preset by name, or else a file by path.
     pub fn preset_or_file(name_or_path: &str) -> Result<Scene, SceneError> {
+        let path = Path::new(name_or_path);
         if PRESETS.contains(&name_or_path) {
             Scene::preset(name_or_path)
+        } else if !path.exists() {
+            Err(SceneError {
+                file: name_or_path.to_owned(),
+                line: None,
+                column: None,
+                field: None,
+                message: format!(
+                    "no such preset or file; the presets are: {}",
+                    PRESETS.join(", ")
+                ),
+            })
+        } else if path.is_dir() {
+            Err(SceneError {
+                file: name_or_path.to_owned(),
+                line: None,
+                column: None,
+                field: None,
+                message: "is a directory, not a scene file (TOML)".to_owned(),
+            })
         } else {
-            Scene::load(Path::new(name_or_path))
+            Scene::load(path)
         }
     }
 

@@ -58,3 +58,79 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
         d
     }
 }
+
+/// The path of a binary of this workspace (`pushbot`, `pushbot-sim`), built first if needed.
+///
+/// `cargo test -p pushbot-tests` builds this package's dependencies as libraries only, so the
+/// binaries are built here (once per test process) with the cargo that runs the tests, into
+/// the same target directory and profile as the test itself.
+pub fn bin(name: &str) -> std::path::PathBuf {
+    use std::sync::{Mutex, OnceLock};
+    static BUILT: OnceLock<Mutex<Vec<String>>> = OnceLock::new();
+    let exe = std::env::current_exe().expect("the test's own path");
+    // target/<profile>/deps/<test>-<hash>
+    let dir = exe
+        .parent()
+        .and_then(|d| d.parent())
+        .expect("the test runs from target/<profile>/deps")
+        .to_path_buf();
+    let path = dir.join(name);
+    let package = match name {
+        "pushbot" => "pushbot",
+        "pushbot-sim" => "pushbot-sim",
+        other => panic!("no binary {other} in this workspace"),
+    };
+    let mut built = BUILT
+        .get_or_init(|| Mutex::new(Vec::new()))
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if !built.iter().any(|b| b == name) {
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let mut cmd = std::process::Command::new(cargo);
+        cmd.args(["build", "--quiet", "-p", package, "--bin", name]);
+        if dir.file_name().is_some_and(|p| p == "release") {
+            cmd.arg("--release");
+        }
+        // Build where the test was built.
+        if let Some(target) = dir.parent() {
+            cmd.env("CARGO_TARGET_DIR", target);
+        }
+        let status = cmd
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .status()
+            .expect("run cargo build");
+        assert!(
+            status.success(),
+            "cargo build -p {package} --bin {name} failed"
+        );
+        built.push(name.to_owned());
+    }
+    assert!(path.exists(), "{} was not built", path.display());
+    path
+}
+
+/// What a run of a binary gave: exit code (`None`: killed by a signal), stdout, stderr.
+#[derive(Debug)]
+pub struct Run {
+    /// Exit code; `None` if a signal ended the process.
+    pub code: Option<i32>,
+    /// Standard output.
+    pub stdout: String,
+    /// Standard error.
+    pub stderr: String,
+}
+
+/// Run a workspace binary with `args` (standard input closed) and collect what it gave.
+pub fn run_bin(name: &str, args: &[&str]) -> Run {
+    let out = std::process::Command::new(bin(name))
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .env_remove("PUSHBOT_LOG")
+        .output()
+        .expect("start the binary");
+    Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}

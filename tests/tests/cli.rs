@@ -55,3 +55,174 @@ fn bad_ports_and_values_are_bad_input() {
     let err = cli(&["robot", "move", "--distance", "0.1", "--speed", "5"]).unwrap_err();
     assert!(matches!(err, CliError::BadInput(_)), "{err}");
 }
+
+/// Every command's path below `pushbot` (`[]` is `pushbot` itself), from the real command tree.
+fn command_paths() -> Vec<Vec<String>> {
+    fn walk(cmd: &clap::Command, path: Vec<String>, out: &mut Vec<Vec<String>>) {
+        for sub in cmd.get_subcommands() {
+            if sub.get_name() == "help" {
+                continue;
+            }
+            let mut p = path.clone();
+            p.push(sub.get_name().to_owned());
+            walk(sub, p, out);
+        }
+        out.push(path);
+    }
+    let mut out = Vec::new();
+    walk(&pushbot::cli::command(), Vec::new(), &mut out);
+    out
+}
+
+#[test]
+fn every_command_help_ends_with_an_example_of_itself() {
+    let paths = command_paths();
+    assert!(paths.len() > 20, "{paths:?}");
+    for path in paths {
+        let mut args: Vec<&str> = path.iter().map(String::as_str).collect();
+        args.push("--help");
+        let r = pushbot_tests::run_bin("pushbot", &args);
+        assert_eq!(r.code, Some(0), "{args:?}: {r:?}");
+        let (_, example) = r
+            .stdout
+            .split_once("\nExample:\n")
+            .or_else(|| r.stdout.split_once("\nExamples:\n"))
+            .unwrap_or_else(|| {
+                panic!("`pushbot {}` has no example:\n{}", path.join(" "), r.stdout)
+            });
+        let first = example.lines().next().unwrap_or_default().trim();
+        let want = ["pushbot".to_owned()]
+            .into_iter()
+            .chain(path.iter().cloned())
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(
+            first.starts_with(&want),
+            "the example of `{want}` is `{first}`"
+        );
+    }
+}
+
+#[test]
+fn every_example_parses_and_names_a_command() {
+    let paths: Vec<String> = command_paths().iter().map(|p| p.join(" ")).collect();
+    for (path, text) in pushbot::cli::EXAMPLES {
+        assert!(paths.contains(&path.to_string()), "no command `{path}`");
+        for line in text.lines() {
+            let argv: Vec<&str> = line.split_whitespace().collect();
+            assert_eq!(argv.first(), Some(&"pushbot"), "{line}");
+            let parsed = pushbot::cli::command().try_get_matches_from(&argv);
+            assert!(
+                parsed.is_ok(),
+                "`{line}` does not parse: {:?}",
+                parsed.err()
+            );
+        }
+    }
+}
+
+#[test]
+fn the_documented_global_flags_are_everywhere() {
+    // --json, --seed and -v on every command; --scene wherever a world is simulated or planned.
+    for path in command_paths() {
+        let mut args: Vec<&str> = path.iter().map(String::as_str).collect();
+        args.push("--help");
+        let help = pushbot::cli::command()
+            .try_get_matches_from(["pushbot"].into_iter().chain(args.iter().copied()))
+            .unwrap_err()
+            .render()
+            .to_string();
+        for flag in ["--json", "--seed", "--verbose"] {
+            assert!(
+                help.contains(flag),
+                "`pushbot {}` lacks {flag}",
+                path.join(" ")
+            );
+        }
+    }
+}
+
+/// Run `pushbot args` with its standard output a pipe whose reader has already gone.
+fn into_closed_pipe(args: &[&str]) -> std::process::Output {
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    std::process::Command::new(pushbot_tests::bin("pushbot"))
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start pushbot")
+        .wait_with_output()
+        .expect("wait for pushbot")
+}
+
+#[test]
+fn a_closed_pipe_ends_the_command_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    for args in [
+        &["scene", "list"][..],
+        &["plan", "rearrange", "--scene", "A1"],
+        &["--help"],
+        &["robot", "move", "--help"],
+    ] {
+        let out = into_closed_pipe(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        // Killed by SIGPIPE, like any Unix filter (not the panic's exit code 101).
+        assert_eq!(out.status.signal(), Some(13), "{args:?}: {:?}", out.status);
+    }
+}
+
+#[test]
+fn piped_into_head_gives_one_line_and_no_noise() {
+    let bin = pushbot_tests::bin("pushbot");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("'{}' scene list | head -1", bin.display()))
+        .output()
+        .expect("run sh");
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).lines().count(),
+        1,
+        "{out:?}"
+    );
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn logs_go_to_stderr_at_the_level_of_v() {
+    // Quiet by default: only the result, on stdout.
+    let r = pushbot_tests::run_bin("pushbot", &["--json", "robot", "info", "--seed", "3"]);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    assert!(!r.stderr.contains("built-in simulated robot"), "{r:?}");
+    let v: serde_json::Value = serde_json::from_str(r.stdout.trim()).expect("one JSON object");
+    assert_eq!(v["simulated"], true, "{v}");
+    // -v: info logs on stderr, stdout still one JSON object; --scene picks the sim's world.
+    let r = pushbot_tests::run_bin(
+        "pushbot",
+        &["-v", "robot", "info", "--json", "--scene", "three-boxes"],
+    );
+    assert_eq!(r.code, Some(0), "{r:?}");
+    assert!(r.stderr.contains("INFO"), "{r:?}");
+    assert!(
+        r.stderr.contains("built-in simulated robot on /dev/pts/"),
+        "{r:?}"
+    );
+    let v: serde_json::Value = serde_json::from_str(r.stdout.trim()).expect("one JSON object");
+    assert_eq!(v["command"], "info", "{v}");
+}
+
+#[test]
+fn exit_codes_are_in_the_top_level_help() {
+    let r = pushbot_tests::run_bin("pushbot", &["--help"]);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    for needle in ["Exit status: 0 success", "1 the task failed", "2 bad input"] {
+        assert!(r.stdout.contains(needle), "{needle}: {}", r.stdout);
+    }
+}

@@ -2,14 +2,18 @@
 //!
 //! Exit codes: 0 success, 1 the task failed (goal not reached, no plan exists, the robot
 //! faulted, the link died), 2 bad input (arguments, scene files, ports that are not serial).
+//! Errors go to stderr as `error: …`; with `--json` they are also printed on stdout as one
+//! JSON object `{"error": {"kind": "bad_input" | "failed", "message": …, "exit_code": …}}`.
+//! Every command's `--help` ends with an example ([`EXAMPLES`]).
 
 use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub mod demo;
 pub mod rearrange;
 pub mod robot;
+pub mod scene;
 pub mod stable;
 pub mod strategy;
 pub mod vision;
@@ -62,6 +66,9 @@ pub enum Command {
     /// Measure planners and pipelines; prints numbers.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Scene files: check one (`scene check`), list the built-in presets (`scene list`).
+    #[command(subcommand)]
+    Scene(scene::SceneCommand),
 }
 
 /// `pushbot plan …`.
@@ -116,23 +123,158 @@ impl CliError {
 /// What every command's `run` returns.
 pub type CliResult = Result<Status, CliError>;
 
+/// An example for every command, by its path below `pushbot` (`""` is `pushbot` itself):
+/// shown at the end of its `--help`. Each line is a whole command line that parses.
+pub const EXAMPLES: &[(&str, &str)] = &[
+    (
+        "",
+        "pushbot robot info\n  pushbot plan rearrange --scene A1 --svg a1.svg",
+    ),
+    (
+        "robot",
+        "pushbot robot info --port /dev/ttyACM0\n  pushbot robot move --distance 0.2 --scene three-boxes",
+    ),
+    (
+        "robot info",
+        "pushbot robot info --port /dev/ttyACM0 --json",
+    ),
+    (
+        "robot move",
+        "pushbot robot move --distance -0.1 --speed 0.05 --port /dev/ttyACM0",
+    ),
+    ("robot spin", "pushbot robot spin --angle -90 --rate 45"),
+    ("robot stop", "pushbot robot stop --port /dev/ttyACM0"),
+    ("robot estop", "pushbot robot estop --port /dev/ttyACM0"),
+    (
+        "robot clear-faults",
+        "pushbot robot clear-faults --port /dev/ttyACM0",
+    ),
+    ("mechanics", "pushbot mechanics --scene fig13 --json"),
+    ("plan", "pushbot plan stable --scene fig16 --svg fig16.svg"),
+    (
+        "plan rearrange",
+        "pushbot plan rearrange --scene A1 --svg a1.svg",
+    ),
+    (
+        "plan stable",
+        "pushbot plan stable --scene fig16 --exact-goal --svg fig16.svg",
+    ),
+    (
+        "collect",
+        "pushbot collect --object irregular --out irregular.strategy --seed 3",
+    ),
+    (
+        "eval",
+        "pushbot eval delivery --scene lau-irregular --start A,C --trials 5",
+    ),
+    (
+        "eval delivery",
+        "pushbot eval delivery --scene lau-irregular --strategy irregular.strategy --trials 5",
+    ),
+    (
+        "calibrate",
+        "pushbot calibrate --camera /dev/video0 --scene lau-irregular --out calibration.json",
+    ),
+    (
+        "track",
+        "pushbot track --camera sim:127.0.0.1:5600 --scene lau-irregular --frames 100 --json",
+    ),
+    ("bench", "pushbot bench stable --repeat 3"),
+    ("bench rearrange", "pushbot bench rearrange --quick"),
+    ("bench stable", "pushbot bench stable --repeat 3 --json"),
+    ("bench vision", "pushbot bench vision --frames 50"),
+    (
+        "bench knn",
+        "pushbot bench knn --samples 10000 --queries 500",
+    ),
+    ("scene", "pushbot scene check --scene my-table.toml"),
+    (
+        "scene check",
+        "pushbot scene check --scene my-table.toml --json",
+    ),
+    ("scene list", "pushbot scene list"),
+];
+
+/// The exit codes, as `pushbot --help` states them.
+const EXIT_CODES: &str = "\n\nExit status: 0 success; 1 the task failed (no plan exists, goal not \
+     reached, the robot faulted, the link died); 2 bad input (arguments, files, devices).\n\
+     Logs go to stderr (-v info, -vv debug, -vvv trace, or PUSHBOT_LOG=<filter>).";
+
+/// Report a task that ran but failed with `message` (exit code 1 follows): `error: …` on
+/// stderr, and with `--json` the same error object on stdout as [`main`] prints.
+pub fn task_failed(g: &Global, message: &str) -> Status {
+    eprintln!("error: {message}");
+    if g.json {
+        print_json_error("failed", message, 1);
+    }
+    Status::TaskFailed
+}
+
+fn with_examples(mut cmd: clap::Command, path: &str) -> clap::Command {
+    if let Some((_, ex)) = EXAMPLES.iter().find(|(p, _)| *p == path) {
+        let mut help = format!("Example:\n  {ex}");
+        if path.is_empty() {
+            help.push_str(EXIT_CODES);
+        }
+        cmd = cmd.after_help(help);
+    }
+    let names: Vec<String> = cmd
+        .get_subcommands()
+        .map(|c| c.get_name().to_owned())
+        .collect();
+    for name in names {
+        let sub_path = if path.is_empty() {
+            name.clone()
+        } else {
+            format!("{path} {name}")
+        };
+        cmd = cmd.mut_subcommand(&name, |c| with_examples(c, &sub_path));
+    }
+    cmd
+}
+
+/// The `pushbot` command line as clap sees it, with [`EXAMPLES`] in each command's help.
+pub fn command() -> clap::Command {
+    with_examples(Cli::command(), "")
+}
+
 /// Parse arguments, run, map the result to an exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let json = std::env::args_os().any(|a| a == "--json");
+    let cli = match command()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m))
+    {
+        Ok(cli) => cli,
+        Err(e) => {
+            // Help and version are "errors" that print to stdout and exit 0.
+            if json && e.use_stderr() {
+                let text = e.render().to_string();
+                let first = text.lines().next().unwrap_or_default();
+                print_json_error("bad_input", first.trim_start_matches("error: "), 2);
+            }
+            e.exit()
+        }
+    };
     init_logging(cli.global.verbose);
+    let json = cli.global.json;
     let result = run(cli);
-    match result {
-        Ok(Status::Success) => ExitCode::SUCCESS,
-        Ok(Status::TaskFailed) => ExitCode::from(1),
-        Err(CliError::Failed(e)) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(1)
-        }
-        Err(CliError::BadInput(e)) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
+    let (kind, e, code) = match result {
+        Ok(Status::Success) => return ExitCode::SUCCESS,
+        Ok(Status::TaskFailed) => return ExitCode::from(1),
+        Err(CliError::Failed(e)) => ("failed", e, 1),
+        Err(CliError::BadInput(e)) => ("bad_input", e, 2),
+    };
+    eprintln!("error: {e:#}");
+    if json {
+        print_json_error(kind, &format!("{e:#}"), code);
     }
+    ExitCode::from(code)
+}
+
+fn print_json_error(kind: &str, message: &str, code: u8) {
+    let v = serde_json::json!({"error": {"kind": kind, "message": message, "exit_code": code}});
+    println!("{v}");
 }
 
 fn init_logging(verbose: u8) {
@@ -169,5 +311,6 @@ pub fn run(cli: Cli) -> CliResult {
         }
         Command::Collect(args) => strategy::run_collect(&global, args),
         Command::Eval(args) => strategy::run_eval(&global, args),
+        Command::Scene(cmd) => scene::run(&global, cmd),
     }
 }

@@ -15,6 +15,15 @@ pub struct RobotArgs {
     /// started and reached through a pseudo-terminal.
     #[arg(long, global = true, value_name = "PATH")]
     pub port: Option<String>,
+    /// The world of the built-in simulated robot (preset name or TOML file): its table,
+    /// obstacles, objects and the robot's start. Not with `--port`.
+    #[arg(
+        long,
+        global = true,
+        value_name = "PRESET|FILE",
+        conflicts_with = "port"
+    )]
+    pub scene: Option<String>,
     /// Pace of the built-in simulated robot against the wall clock (10 = ten times real time).
     #[arg(long, global = true, default_value_t = 10.0, value_name = "X")]
     pub sim_speed: f64,
@@ -147,9 +156,17 @@ impl Target {
                         args.sim_speed
                     )));
                 }
+                let scene = match &args.scene {
+                    Some(s) => Some(
+                        pushbot_sim::Scene::preset_or_file(s)
+                            .map_err(|e| CliError::bad_input(e.to_string()))?,
+                    ),
+                    None => None,
+                };
                 let sim = pushbot_sim::PtySim::start(pushbot_sim::SimOptions {
                     seed,
                     speed: args.sim_speed,
+                    scene,
                     ..Default::default()
                 })
                 .map_err(|e| {

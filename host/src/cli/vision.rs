@@ -131,13 +131,13 @@ fn calibrate_from(
 /// `pushbot calibrate`.
 pub fn calibrate(g: &Global, args: CalibrateArgs) -> CliResult {
     let lay = layout(&args.camera)?;
+    if args.frames == 0 {
+        return Err(CliError::bad_input("--frames must be at least 1"));
+    }
     let mut src = source(&args.camera)?;
     let cal = match calibrate_from(src.as_mut(), &args.camera, &lay, args.frames)? {
         Ok(c) => c,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            return Ok(Status::TaskFailed);
-        }
+        Err(msg) => return Ok(super::task_failed(g, &msg)),
     };
     cal.save(&args.out)
         .map_err(|e| CliError::Failed(e.into()))?;
@@ -162,15 +162,20 @@ pub fn calibrate(g: &Global, args: CalibrateArgs) -> CliResult {
 /// `pushbot track`.
 pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     let lay = layout(&args.camera)?;
+    // Files are checked before the camera is opened.
+    let saved = match &args.calibration {
+        Some(p) => Some(Calibration::load(p).map_err(CliError::bad_input)?),
+        None => None,
+    };
+    if args.frames == Some(0) {
+        return Err(CliError::bad_input("--frames must be at least 1"));
+    }
     let mut src = source(&args.camera)?;
-    let cal = match &args.calibration {
-        Some(p) => Calibration::load(p).map_err(CliError::bad_input)?,
+    let cal = match saved {
+        Some(c) => c,
         None => match calibrate_from(src.as_mut(), &args.camera, &lay, 1)? {
             Ok(c) => c,
-            Err(msg) => {
-                eprintln!("error: {msg}");
-                return Ok(Status::TaskFailed);
-            }
+            Err(msg) => return Ok(super::task_failed(g, &msg)),
         },
     };
     let det = make_detector(args.camera.detector, &lay.families())

@@ -68,7 +68,15 @@ pub fn open_source(spec: &str, fps: f64) -> Result<Box<dyn FrameSource>, SourceE
     if path.is_dir() {
         return Ok(Box::new(super::folder::FolderSource::open(path, fps)?));
     }
+    let what = if spec.is_empty() {
+        "is empty".to_owned()
+    } else if !path.exists() {
+        "does not exist".to_owned()
+    } else {
+        "is not a directory".to_owned()
+    };
     Err(SourceError::BadSource(format!(
-        "camera source {spec:?} is neither a V4L2 device (/dev/videoN), a sim socket (sim:HOST:PORT) nor a directory of images"
+        "camera source {spec:?} {what}: give a V4L2 device (/dev/videoN), the sim camera \
+         (sim:HOST:PORT) or a directory of images"
     )))
 }
