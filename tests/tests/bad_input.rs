@@ -213,7 +213,6 @@ fn scene_object_outside_the_table() {
 }
 
 #[test]
-#[ignore = "needs the scene overlap check (issue 4)"]
 fn scene_object_overlapping_an_obstacle() {
     let f = Files::new();
     // The box's centre on the obstacle's edge.

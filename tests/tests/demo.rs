@@ -52,7 +52,7 @@ fn an_unknown_stage_or_scene_is_bad_input() {
             Err(CliError::BadInput(e)) => {
                 let msg = format!("{e:#}");
                 assert!(
-                    msg.contains(extra[1].split('=').last().unwrap_or("")),
+                    msg.contains(extra[1].split('=').next_back().unwrap_or("")),
                     "{msg}"
                 );
             }

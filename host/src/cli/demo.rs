@@ -59,7 +59,7 @@ pub struct DemoArgs {
     #[arg(long, requires = "port")]
     pub camera: Option<String>,
     /// Simulated seconds per wall second of the built-in target.
-    #[arg(long, default_value_t = 8.0)]
+    #[arg(long = "sim-speed", alias = "speed", default_value_t = 8.0)]
     pub speed: f64,
     /// Also render every figure as PNG.
     #[arg(long)]
@@ -195,7 +195,7 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
     }
     if !(args.speed.is_finite() && args.speed > 0.0 && args.speed <= 50.0) {
         return Err(CliError::bad_input(format!(
-            "--speed must be in (0, 50], not {}",
+            "--sim-speed must be in (0, 50], not {}",
             args.speed
         )));
     }
@@ -208,6 +208,11 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
     crate::planner::stable::presets::load_scene(&stable_name)
         .map_err(|e| CliError::bad_input(format!("{e:#}")))?;
 
+    if let (Some(port), Some(camera)) = (&args.port, &args.camera) {
+        drop(crate::link::transport::open(port).map_err(|e| CliError::bad_input(format!("{e}")))?);
+        crate::exec::grabber::FrameGrabber::open(camera, 30.0)
+            .map_err(|e| CliError::bad_input(format!("--camera {camera}: {e}")))?;
+    }
     let report = Report::create(&args.out, "pushbot demo", args.png).map_err(CliError::Failed)?;
     let log = std::fs::File::create(args.out.join("demo.log"))
         .map_err(|e| CliError::Failed(anyhow!("creating demo.log: {e}")))?;
