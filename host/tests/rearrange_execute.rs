@@ -140,6 +140,8 @@ fn boxes_left_off_their_cells_are_snapped_and_the_plan_is_restored_from_the_same
             "no deviation was provoked: {report:?}"
         );
         // Restoration stops as soon as every box is in its goal cell, centred or not.
-        assert_at_goals(&p, &io.inner, 0.5 * cell);
+        // Inside the goal cell, up to what the camera can tell: with 1 mm of position noise a
+        // box whose edge lies on the cell border is snapped to either side (3σ = 3 mm).
+        assert_at_goals(&p, &io.inner, 0.5 * cell + 0.003);
     }
 }
