@@ -220,7 +220,9 @@ fn lost_ack_is_retried_with_the_same_seq_and_executed_once() {
         .iter()
         .filter(|f| matches!(f.cmd, Command::Spin { .. }))
         .collect();
-    assert_eq!(spins.len(), 3, "sent three times");
+    // Two answers are dropped, so at least three sendings; a host slowed down by a loaded
+    // machine may resend once more, which must change nothing.
+    assert!(spins.len() >= 3, "sent {} times", spins.len());
     assert!(spins.iter().all(|f| f.seq == spins[0].seq), "same seq");
     assert_eq!(
         s.executed
@@ -229,7 +231,9 @@ fn lost_ack_is_retried_with_the_same_seq_and_executed_once() {
             .count(),
         1
     );
-    assert_eq!(robot.stats().retries, 2);
+    let retries = robot.stats().retries;
+    drop(s);
+    assert!(retries >= 2, "{retries} retries");
 }
 
 #[test]
