@@ -153,7 +153,6 @@ fn delivery_adds_supplemental_samples_at_once() {
 }
 
 #[test]
-#[ignore = "fails with TimeLimit after the sim's multi-contact solve landed (issue 6 note); run with --ignored"]
 fn collect_once_then_deliver_around_a_wall_from_the_cache() {
     use pushbot::strategy::obstacles::{
         ObstacleParams, clearance, collect_and_deliver, collect_or_load, scene_obstacles,

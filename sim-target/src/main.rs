@@ -24,6 +24,15 @@ use pushbot_sim::{Pose, PtySim, Scene, SimOptions};
 struct Cli {
     #[command(subcommand)]
     command: Option<Sub>,
+    /// More log output on stderr: the firmware's own log (-v warnings, -vv info, -vvv debug).
+    /// `PUSHBOT_LOG=<filter>` overrides it, as for `pushbot`.
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    verbose: u8,
+    /// JSON output: `replay` prints one JSON object instead of CSV lines, and an error is one
+    /// JSON object on stdout, `{"error": {"kind", "message", "exit_code"}}`, as `pushbot --json`
+    /// prints them (the simulator's first line is JSON anyway).
+    #[arg(long, global = true)]
+    json: bool,
     /// A scene: a preset name (see `pushbot-sim presets`) or a TOML file. Its table, obstacles,
     /// objects and robot replace --table and --start.
     #[arg(long, value_name = "PRESET|FILE")]
@@ -124,9 +133,6 @@ enum Sub {
         /// of the scene robot's bumper radius.
         #[arg(long, value_name = "FILE.csv")]
         pusher: PathBuf,
-        /// Print one JSON object instead of CSV lines.
-        #[arg(long)]
-        json: bool,
     },
     /// List the built-in scene presets.
     Presets,
@@ -168,12 +174,13 @@ fn main() {
     // with MSG_NOSIGNAL by std and the pty gives EIO, so neither can raise the signal.
     sigpipe::reset();
     let cli = Cli::parse();
+    init_logging(cli.verbose);
+    let json = cli.json;
     let result = match cli.command {
         Some(Sub::Replay {
             ref scene,
             ref object,
             ref pusher,
-            json,
         }) => replay(scene, object, pusher, json),
         Some(Sub::Bench { ref scene, seconds }) => bench(scene, seconds),
         Some(Sub::Presets) => {
@@ -185,11 +192,38 @@ fn main() {
         None => run(cli),
     };
     if let Err(e) = result {
-        eprintln!("pushbot-sim: {e:#}");
         let bad = e.downcast_ref::<BadInput>().is_some()
             || e.downcast_ref::<pushbot_sim::scene::SceneError>().is_some();
-        std::process::exit(if bad { 2 } else { 1 });
+        let code = if bad { 2 } else { 1 };
+        if json {
+            let v = serde_json::json!({"error": {
+                "kind": if bad { "bad_input" } else { "failed" },
+                "message": format!("{e:#}"),
+                "exit_code": code,
+            }});
+            println!("{v}");
+        } else {
+            eprintln!("pushbot-sim: {e:#}");
+        }
+        std::process::exit(code);
     }
+}
+
+/// Log to stderr: nothing by default, the firmware's warnings with -v, info -vv, debug -vvv.
+fn init_logging(verbose: u8) {
+    let level = match verbose {
+        0 => "off",
+        1 => "warn",
+        2 => "info",
+        3 => "debug",
+        _ => "trace",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_env("PUSHBOT_LOG")
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
 }
 
 fn run(cli: Cli) -> Result<()> {

@@ -115,6 +115,27 @@ fn binary_refuses_bad_arguments() {
     }
 }
 
+/// `--json`: an error is one JSON object on stdout naming what is wrong, with exit code 2 for
+/// bad input; `-v` is accepted everywhere.
+#[test]
+fn binary_prints_errors_as_json() {
+    let out = Process::new(env!("CARGO_BIN_EXE_pushbot-sim"))
+        .args(["-v", "--json", "--scene", "no-such-scene"])
+        .stdin(Stdio::null())
+        .output()
+        .expect("run");
+    assert_eq!(out.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let v: serde_json::Value = serde_json::from_str(text.trim()).expect("one JSON object");
+    assert_eq!(v["error"]["kind"], "bad_input");
+    assert_eq!(v["error"]["exit_code"], 2);
+    let msg = v["error"]["message"].as_str().expect("message");
+    assert!(
+        msg.contains("no-such-scene") && msg.contains("lau-irregular"),
+        "{msg}"
+    );
+}
+
 /// `replay`: a straight pusher path through the slider's centre translates it; the output is
 /// one JSON object with a row per CSV sample.
 #[test]

@@ -9,7 +9,7 @@ use pushbot_sim::Scene;
 use pushbot_tests::SIM_SPEED;
 
 #[test]
-#[ignore = "not yet seen passing: several minutes through the live link (issue 6 note); run with --ignored"]
+
 fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     let scene = Scene::preset("lau-irregular").expect("preset");
     let goal = scene.goals[0].pose;
@@ -30,7 +30,7 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
         "--method",
         "learned",
         "--initial",
-        "160",
+        "120",
         "--streak",
         "0",
         "--trials",

@@ -246,10 +246,10 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
         };
         rep.wall_s = started.elapsed().as_secs_f64();
         ctx.log(&format!(
-            "stage {stage}: {} in {:.1} s wall, {:.1} s robot",
+            "stage {stage}: {} in {:.1} s wall, {:.1} s mission time",
             if rep.success { "reached" } else { "FAILED" },
             rep.wall_s,
-            rep.robot_s
+            rep.mission_s
         ));
         for n in &rep.notes {
             ctx.log(&format!("  {n}"));
@@ -373,7 +373,7 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
     pb.finish_and_clear();
     let d = &res.delivery;
     st.success = d.success;
-    st.robot_s = d.time;
+    st.mission_s = d.time;
     st.number("steps", d.steps);
     st.number("repositions", d.repositions);
     st.number("subgoals", res.subgoals.len());
@@ -391,7 +391,7 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
         st.notes.push(format!("delivery failed: {why:?}"));
     }
     st.notes.push(format!(
-        "{} samples ({}); delivered in {} pushes, {:.0} s of robot time",
+        "{} samples ({}); delivered in {} pushes, {:.0} s of mission time",
         samples.len(),
         if collection.is_some() {
             "collected now"
@@ -466,7 +466,7 @@ fn stage_rearrange(
     let (rep, trace) = ctx.with_robot(&scene, None, &ids, |io| execute(&model, &map, io, &exec))?;
     pb.finish_and_clear();
     st.success = rep.reached;
-    st.robot_s = rep.time_s;
+    st.mission_s = rep.time_s;
     st.number("executed_cost", rep.executed_cost);
     st.number("pushes", rep.pushes);
     st.number("deviations_snapped", rep.deviations);
@@ -524,7 +524,7 @@ fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
         .fold(0.0, f64::max);
     let worst_angle = pushes.iter().map(|r| r.drift_angle).fold(0.0, f64::max);
     st.success = p.in_goal(&end);
-    st.robot_s = trace.last().map_or(0.0, |t| t.t - trace[0].t);
+    st.mission_s = trace.last().map_or(0.0, |t| t.t - trace[0].t);
     st.number("pushed_m", pushed);
     st.number("worst_drift_per_100mm_mm", worst * 100.0);
     st.number("worst_drift_deg", worst_angle.to_degrees());

@@ -278,9 +278,11 @@ fn print_json_error(kind: &str, message: &str, code: u8) {
 }
 
 fn init_logging(verbose: u8) {
+    // The firmware's own log (when the built-in simulated target runs it in this process) is the
+    // robot's business: its stalls and timeouts reach the host as faults over the link anyway.
     let level = match verbose {
-        0 => "warn",
-        1 => "info",
+        0 => "warn,pushbot_firmware=error",
+        1 => "info,pushbot_firmware=warn",
         2 => "debug",
         _ => "trace",
     };

@@ -98,6 +98,11 @@ pub struct LiveRobot {
     /// Why the camera stopped, once it has: the next primitive fails with it.
     camera_error: Option<String>,
     t0_us: u64,
+    /// Wall instant and robot clock (s) when the robot last went idle (end of a primitive).
+    idle_since: (std::time::Instant, f64),
+    /// Mission time minus the robot's clock, s: the host's idle periods counted at wall-clock
+    /// rate instead of the robot's (see [`RobotIo::time`] below).
+    host_adjust: f64,
     frames_seen: u64,
     view: Option<super::view::LiveView>,
 }
@@ -187,6 +192,8 @@ impl LiveRobot {
             fresh: false,
             camera_error: None,
             t0_us,
+            idle_since: (std::time::Instant::now(), 0.0),
+            host_adjust: 0.0,
             frames_seen: 0,
             view,
             opts,
@@ -228,8 +235,16 @@ impl LiveRobot {
         self.poses.get(body).copied()
     }
 
+    /// The robot's clock since connecting, s (from its latest telemetry).
+    pub fn robot_clock(&self) -> f64 {
+        self.robot
+            .telemetry()
+            .map_or(0.0, |t| t.time_us.saturating_sub(self.t0_us) as f64 * 1e-6)
+    }
+
     /// Look now: process fresh frames (taken after this call) and update every body's pose.
     pub fn look(&mut self) -> Result<()> {
+        let (wall, t0) = (std::time::Instant::now(), self.robot_clock());
         // The frame being rendered or exposed right now may show the past: skip it.
         let mut after = self.grabber.count() + 1;
         for _ in 0..self.opts.frames_per_look.max(1) {
@@ -248,6 +263,11 @@ impl LiveRobot {
             }
         }
         self.fresh = true;
+        tracing::debug!(
+            "look: {:.0} ms wall, {:.2} s robot time",
+            wall.elapsed().as_secs_f64() * 1e3,
+            self.robot_clock() - t0
+        );
         Ok(())
     }
 
@@ -275,7 +295,25 @@ impl LiveRobot {
             bail!("the camera stopped: {e}");
         }
         self.fresh = false;
-        for attempt in 0..2 {
+        let (wall, t0) = (std::time::Instant::now(), self.robot_clock());
+        let (idle_wall, idle_robot) = self.idle_since;
+        self.host_adjust += idle_wall.elapsed().as_secs_f64() - (t0 - idle_robot);
+        let out = self.run_motion(what, run);
+        let t1 = self.robot_clock();
+        self.idle_since = (std::time::Instant::now(), t1);
+        tracing::debug!(
+            "{what}: {:.0} ms wall, {:.2} s robot time",
+            wall.elapsed().as_secs_f64() * 1e3,
+            t1 - t0
+        );
+        out
+    }
+
+    fn run_motion(&mut self, what: &str, run: impl Fn(&Robot) -> Result<Outcome>) -> Result<()> {
+        // A refused command never started: clear the faults and send it again, a few times (a
+        // loaded host can let the link watchdog fire again between the clear and the retry).
+        const ATTEMPTS: usize = 4;
+        for attempt in 0..ATTEMPTS {
             match run(&self.robot) {
                 Ok(Outcome::Fault(f)) if f.contains(pushbot_protocol::Faults::LINK_LOST) => {
                     self.clear_faults()?;
@@ -292,7 +330,10 @@ impl LiveRobot {
                     return Ok(());
                 }
                 Ok(_) => return Ok(()),
-                Err(e) if attempt == 0 && is_faulted_refusal(&e) => self.clear_faults()?,
+                Err(e) if attempt + 1 < ATTEMPTS && is_faulted_refusal(&e) => {
+                    tracing::debug!("{what} refused ({e:#}); clearing the faults and retrying");
+                    self.clear_faults()?;
+                }
                 Err(e) => return Err(e.context(format!("{what} on {}", self.robot.path()))),
             }
         }
@@ -388,10 +429,14 @@ impl RobotIo for LiveRobot {
         self.poses.get(id).map(|(p, _)| *p)
     }
 
+    /// Mission time: the robot's clock while it runs primitives, wall-clock time while it waits
+    /// for the host (looking, planning). On hardware the two clocks run together and this is
+    /// the robot's clock; on a simulated target running N× faster than real time, the host's
+    /// work would otherwise count N times over and a delivery would run out of time because the
+    /// simulation is fast, not because the robot was slow.
     fn time(&self) -> f64 {
-        self.robot
-            .telemetry()
-            .map_or(0.0, |t| t.time_us.saturating_sub(self.t0_us) as f64 * 1e-6)
+        let (idle_wall, idle_robot) = self.idle_since;
+        idle_robot + self.host_adjust + idle_wall.elapsed().as_secs_f64()
     }
 
     fn workspace(&self) -> Workspace {

@@ -31,7 +31,7 @@ figure img {{ max-width: 520px; border: 1px solid #ddd; }}
 figcaption {{ font-size: .9em; color: #555; max-width: 520px; }}
 </style></head><body>
 <h1>{t}</h1>
-<table><tr><th>stage</th><th>paper</th><th>result</th><th>wall s</th><th>robot s</th></tr>
+<table><tr><th>stage</th><th>paper</th><th>result</th><th>wall s</th><th>mission s</th></tr>
 "#,
         t = escape(title)
     );
@@ -45,7 +45,7 @@ figcaption {{ font-size: .9em; color: #555; max-width: 520px; }}
             c = if s.success { "ok" } else { "failed" },
             r = if s.success { "reached" } else { "failed" },
             w = s.wall_s,
-            rt = s.robot_s,
+            rt = s.mission_s,
         );
     }
     h.push_str("</table>\n");

@@ -23,8 +23,9 @@ pub struct StageReport {
     pub success: bool,
     /// Wall time it took, s.
     pub wall_s: f64,
-    /// Robot time it took, s.
-    pub robot_s: f64,
+    /// Mission time it took, s: robot motion on the robot's clock, host work (looking,
+    /// planning) at wall-clock rate, as `LiveRobot` counts it.
+    pub mission_s: f64,
     /// Numbers worth reporting (planner times, costs, errors …).
     pub numbers: serde_json::Map<String, serde_json::Value>,
     /// Figures written, relative to the report folder, with captions.
@@ -42,7 +43,7 @@ impl StageReport {
             paper: paper.into(),
             success: false,
             wall_s: 0.0,
-            robot_s: 0.0,
+            mission_s: 0.0,
             numbers: serde_json::Map::new(),
             figures: Vec::new(),
             notes: Vec::new(),

@@ -138,7 +138,7 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             })
             .find(|a| reach.contains(at(*a)))
             .unwrap_or(base);
-        circle_walk(io, o.position(), radius, push_angle, 0.05)?;
+        circle_walk(io, o.position(), radius, push_angle, 0.05, &[])?;
         // (d) Push towards the object until it is back inside.
         let mut still = 0;
         for _ in 0..30 {
@@ -227,6 +227,14 @@ pub fn collect(
             rep.boundary_resets += 1;
             reset_robot_obj_boundary(io, margin, params.epsilon)?;
         }
+        tracing::debug!(
+            "initial collection: {} samples, {} misses, robot {:?}, object {:?}, {:.0} s",
+            rep.initial_samples,
+            rep.misses,
+            io.robot_pose(),
+            io.object_pose(),
+            io.time() - t0
+        );
         let angle = rng.random_range(-params.spin_max..=params.spin_max);
         io.spin(angle)?;
         let (r0, o0) = (io.robot_pose(), io.object_pose());
@@ -257,6 +265,12 @@ pub fn collect(
             reset_robot_obj_boundary(io, margin, params.epsilon)?;
         }
         let goal = random_goal(io, &mut rng, params.goal_min_distance);
+        tracing::debug!(
+            "evaluation query {}: goal {goal:?}, object {:?}, {:.0} s",
+            rep.queries,
+            io.object_pose(),
+            io.time() - t0
+        );
         let mut added = 0;
         let d = deliver_learned(io, strategy, goal, &params.delivery, &mut |s| {
             added += 1;

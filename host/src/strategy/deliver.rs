@@ -16,7 +16,8 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use super::dipole::{self, DipoleCommand, DipoleParams};
-use super::regression::PushStrategy;
+use super::obstacles::clearance;
+use super::regression::{PushStrategy, Reposition};
 use super::robot_io::{RobotIo, Workspace};
 use super::sample::{Pose2, Sample, wrap_angle};
 
@@ -137,18 +138,26 @@ pub fn go_to(io: &mut dyn RobotIo, target: Vector2<f64>, tol: f64) -> Result<()>
     Ok(())
 }
 
+/// Whether the robot's centre may stand at `p`: on the table and clear of every obstacle (by
+/// its radius and 1 cm).
+pub fn robot_fits(ws: &Workspace, obstacles: &[Vec<[f64; 2]>], p: Vector2<f64>) -> bool {
+    ws.reachable().contains(p) && clearance(p, obstacles) > ws.robot_radius + 0.01
+}
+
 /// Move the robot around the circle of radius `radius` about `centre` (Fig. 3 a–c): first to
 /// the circle's closest point, then along it in chords of at most 30° to the point at angle
-/// `to`, going the way that keeps the robot on the table (points the robot cannot reach are
-/// pulled back onto the table).
+/// `to`, going the way that keeps the robot on the table and off the `obstacles` (points the
+/// robot cannot reach are pulled back onto the table).
 pub fn circle_walk(
     io: &mut dyn RobotIo,
     centre: Vector2<f64>,
     radius: f64,
     to: f64,
     tol: f64,
+    obstacles: &[Vec<[f64; 2]>],
 ) -> Result<()> {
-    let reach = io.workspace().reachable();
+    let ws = io.workspace();
+    let reach = ws.reachable();
     let clamp = |p: Vector2<f64>| {
         Vector2::new(
             p.x.clamp(reach.min[0], reach.max[0]),
@@ -181,7 +190,11 @@ pub fn circle_walk(
         let n = (d.abs() / 30f64.to_radians()).ceil().max(1.0) as usize;
         (1..=n).map(|i| from + d * i as f64 / n as f64).collect()
     };
-    let blocked = |pts: &[f64]| pts.iter().filter(|a| !reach.contains(on(**a))).count();
+    let blocked = |pts: &[f64]| {
+        pts.iter()
+            .filter(|a| !robot_fits(&ws, obstacles, on(**a)))
+            .count()
+    };
     let (a, b) = (route(delta), route(other));
     let pts = if blocked(&a) <= blocked(&b) { a } else { b };
     for ang in pts {
@@ -258,6 +271,63 @@ pub fn deliver_learned(
     p: &DeliveryParams,
     sink: &mut dyn FnMut(&Sample) -> Result<()>,
 ) -> Result<Delivery> {
+    deliver_learned_among(io, strategy, goal, p, &[], sink)
+}
+
+/// Wanted directions tried, in order, when the robot cannot stand where the special case puts
+/// it: the direction to the goal, then turned either way by up to 60°.
+const SPECIAL_TURNS_DEG: [f64; 9] = [0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 60.0, -60.0];
+
+/// The special case's re-positioning (Algorithm 2) for an object at `o` wanted to move along
+/// `want` (object frame), where the robot can stand: the stand point and its approach point on
+/// the bound-all circle must be clear of the table's edge and of `obstacles`. When they are not,
+/// the wanted direction is turned a little either way ([`SPECIAL_TURNS_DEG`]); the first
+/// direction whose stand point is clear wins, else the untouched one.
+fn reachable_reposition(
+    strategy: &PushStrategy,
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    o: &Pose2,
+    want: [f64; 2],
+    bound_all: f64,
+) -> Option<Reposition> {
+    let first = strategy.special(want)?;
+    if obstacles.is_empty() {
+        return Some(first);
+    }
+    let clear = |rep: &Reposition| {
+        let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
+        let rel = at - o.position();
+        let approach = if rel.norm() > 1e-9 {
+            o.position() + bound_all * rel.normalize()
+        } else {
+            at
+        };
+        robot_fits(ws, obstacles, at) && robot_fits(ws, obstacles, approach)
+    };
+    if clear(&first) {
+        return Some(first);
+    }
+    SPECIAL_TURNS_DEG[1..]
+        .iter()
+        .filter_map(|deg| {
+            let (s, c) = deg.to_radians().sin_cos();
+            strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])
+        })
+        .find(|rep| clear(rep))
+        .or(Some(first))
+}
+
+/// [`deliver_learned`] among `obstacles` (table-frame polygons): the special case stands the
+/// robot only where it fits and walks the bound-all circle the way the obstacles leave open.
+pub fn deliver_learned_among(
+    io: &mut dyn RobotIo,
+    strategy: &mut PushStrategy,
+    goal: Vector2<f64>,
+    p: &DeliveryParams,
+    obstacles: &[Vec<[f64; 2]>],
+    sink: &mut dyn FnMut(&Sample) -> Result<()>,
+) -> Result<Delivery> {
     let start = io.time();
     let ws = io.workspace();
     let bound_all = bound_all_radius(&ws, p.bound_all_margin);
@@ -277,13 +347,26 @@ pub fn deliver_learned(
         let dist = to_goal.norm();
         let want = o.vector_to_local(to_goal / dist);
         let want = [want.x, want.y];
+        tracing::debug!(
+            "delivery step {steps}: object {:.3} m from the goal, {:.1} s, special {special}, \
+             robot ({:.3}, {:.3}, {:.2}), object ({:.3}, {:.3}, {:.2})",
+            dist,
+            io.time() - start,
+            r.x,
+            r.y,
+            r.theta,
+            o.x,
+            o.y,
+            o.theta
+        );
         let step = if dist > p.fine_radius {
             p.coarse_step
         } else {
             (0.8 * dist).clamp(0.006, p.fine_step)
         };
         let dir_world = if special {
-            let Some(rep) = strategy.special(want) else {
+            let Some(rep) = reachable_reposition(strategy, &ws, obstacles, &o, want, bound_all)
+            else {
                 return Ok(finish(
                     io,
                     start,
@@ -303,6 +386,7 @@ pub fn deliver_learned(
                 bound_all,
                 angle_of(rel),
                 p.heading_tolerance,
+                obstacles,
             )?;
             go_to(io, at, p.heading_tolerance)?;
             o.vector_to_world(Vector2::new(rep.r[0], rep.r[1]))

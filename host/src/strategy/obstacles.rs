@@ -24,7 +24,7 @@ use pathfinding::prelude::astar;
 use pushbot_sim::Scene;
 
 use super::collect::{CollectParams, CollectReport, collect};
-use super::deliver::{Delivery, DeliveryParams, Failure, deliver_learned};
+use super::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};
 use super::regression::{KernelParams, PushStrategy};
 use super::robot_io::{RobotIo, SimRobot, SimRobotOptions, Workspace};
 use super::sample::{Pose2, Sample};
@@ -286,7 +286,7 @@ pub fn deliver_among_obstacles(
             }
         };
         legs += 1;
-        let d = deliver_learned(io, strategy, sub, &leg_params, sink)?;
+        let d = deliver_learned_among(io, strategy, sub, &leg_params, obstacles, sink)?;
         all.steps += d.steps;
         all.repositions += d.repositions;
         all.object_path += d.object_path;
