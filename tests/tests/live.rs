@@ -163,3 +163,41 @@ fn a_png_frame_of_the_lau_layout_shows_every_marker() {
     expected.sort_unstable();
     assert_eq!(found, expected, "markers in the PNG frame");
 }
+
+/// Mission time (what a delivery's time limit counts): the robot's clock while a primitive
+/// runs, the wall clock while the host works. On a target SIM_SPEED times faster than real
+/// time, a second of host work costs one second, not SIM_SPEED.
+#[test]
+fn mission_time_counts_host_work_at_wall_clock_rate() {
+    let scene = Scene::preset("empty").expect("preset");
+    let t = target(&scene, 6);
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, options()).expect("connect");
+    let (m0, r0) = (robot.time(), robot.robot_clock());
+    std::thread::sleep(std::time::Duration::from_secs(1));
+    let (m1, r1) = (robot.time(), robot.robot_clock());
+    assert!(
+        (0.95..1.6).contains(&(m1 - m0)),
+        "idle mission time {:.2} s",
+        m1 - m0
+    );
+    assert!(
+        r1 - r0 > 0.6 * SIM_SPEED,
+        "idle robot time {:.2} s",
+        r1 - r0
+    );
+    // While moving, mission time is robot time: 0.12 m at 0.12 m/s is a second or so.
+    robot.forward(0.12).expect("forward");
+    let (m2, r2) = (robot.time(), robot.robot_clock());
+    let moving_robot = r2 - r1;
+    let moving_mission = m2 - m1;
+    assert!(
+        moving_robot > 0.9,
+        "the move took {moving_robot:.2} s of robot time"
+    );
+    assert!(
+        moving_mission > 0.8 * moving_robot && moving_mission < moving_robot + 1.0,
+        "mission {moving_mission:.2} s for {moving_robot:.2} s of robot time"
+    );
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}

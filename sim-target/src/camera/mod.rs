@@ -200,6 +200,42 @@ pub struct Camera {
     codes: TagCodes,
     rng: ChaCha8Rng,
     seq: u64,
+    /// The last scene drawn and its blurred irradiance: a frame of a scene that has not moved
+    /// (the robot waiting for its host) differs from it only by the sensor's fresh noise.
+    still: Option<Still>,
+}
+
+/// A drawn scene: what was drawn, the blurred irradiance, the markers' ground truth.
+#[derive(Debug, Clone)]
+struct Still {
+    polygons: Vec<Polygon>,
+    markers: Vec<MarkerPlacement>,
+    irradiance: Vec<f32>,
+    truth: Vec<MarkerTruth>,
+}
+
+impl Still {
+    /// Whether `polygons` and `markers` draw the same image as this still (every coordinate
+    /// within a micrometre, a thousandth of a pixel or less).
+    fn same(&self, polygons: &[Polygon], markers: &[MarkerPlacement]) -> bool {
+        const EPS: f64 = 1e-6;
+        let close =
+            |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() <= EPS && (a[1] - b[1]).abs() <= EPS;
+        self.polygons.len() == polygons.len()
+            && self.markers.len() == markers.len()
+            && self.polygons.iter().zip(polygons).all(|(a, b)| {
+                a.shade == b.shade
+                    && a.points.len() == b.points.len()
+                    && a.points.iter().zip(&b.points).all(|(p, q)| close(*p, *q))
+            })
+            && self.markers.iter().zip(markers).all(|(a, b)| {
+                a.id == b.id
+                    && a.family == b.family
+                    && a.side == b.side
+                    && close(a.centre, b.centre)
+                    && (a.heading - b.heading).abs() <= EPS
+            })
+    }
 }
 
 impl Camera {
@@ -223,6 +259,7 @@ impl Camera {
             codes: TagCodes::new().map_err(CameraError::Invalid)?,
             rng: ChaCha8Rng::seed_from_u64(seed),
             seq: 0,
+            still: None,
         })
     }
 
@@ -243,6 +280,44 @@ impl Camera {
         polygons: &[Polygon],
         markers: &[MarkerPlacement],
     ) -> Result<CameraFrame, CameraError> {
+        if !self
+            .still
+            .as_ref()
+            .is_some_and(|s| s.same(polygons, markers))
+        {
+            self.still = Some(self.draw(polygons, markers)?);
+        }
+        let Some(still) = &self.still else {
+            return Err(CameraError::Invalid("no image drawn".into()));
+        };
+        let cfg = &self.config;
+        let im = &cfg.imaging;
+        let pixels = render::develop(
+            &still.irradiance,
+            im.exposure,
+            im.black_level,
+            im.white_level,
+            im.noise_sigma,
+            &mut self.rng,
+        );
+        let frame = CameraFrame {
+            seq: self.seq,
+            time,
+            width: cfg.model.width,
+            height: cfg.model.height,
+            pixels,
+            truth: still.truth.clone(),
+        };
+        self.seq += 1;
+        Ok(frame)
+    }
+
+    /// Draw the table, `polygons` and `markers` and blur them as the lens does.
+    fn draw(
+        &self,
+        polygons: &[Polygon],
+        markers: &[MarkerPlacement],
+    ) -> Result<Still, CameraError> {
         let cfg = &self.config;
         let im = &cfg.imaging;
         let (w, h) = (cfg.model.width as usize, cfg.model.height as usize);
@@ -286,24 +361,12 @@ impl Camera {
             });
         }
         render::gaussian_blur(&mut canvas.data, w, h, im.blur_sigma_px);
-        let pixels = render::develop(
-            &canvas.data,
-            im.exposure,
-            im.black_level,
-            im.white_level,
-            im.noise_sigma,
-            &mut self.rng,
-        );
-        let frame = CameraFrame {
-            seq: self.seq,
-            time,
-            width: cfg.model.width,
-            height: cfg.model.height,
-            pixels,
+        Ok(Still {
+            polygons: polygons.to_vec(),
+            markers: markers.to_vec(),
+            irradiance: canvas.data,
             truth,
-        };
-        self.seq += 1;
-        Ok(frame)
+        })
     }
 }
 
@@ -325,6 +388,58 @@ mod tests {
         assert!(
             (c[0] - 480.0).abs() < 1e-9 && (c[1] - 360.0).abs() < 1e-9,
             "centre stays: {c:?}"
+        );
+    }
+
+    /// A still scene is drawn once: the next frame has the same image under fresh noise, the
+    /// same truth, and equals what a fresh camera draws; a moved marker is drawn anew.
+    #[test]
+    fn a_still_scene_is_drawn_once_and_a_moved_one_again() {
+        let cfg = CameraConfig::default_for_table([1.2, 0.9]);
+        let m = MarkerPlacement {
+            id: 3,
+            family: MarkerFamily::Tag36h11,
+            centre: [0.5, 0.4],
+            heading: 0.2,
+            side: 0.05,
+        };
+        let mut cam = Camera::new(cfg, 9).unwrap();
+        let a = cam.capture(0.0, &[], &[m]).unwrap();
+        let b = cam.capture(0.1, &[], &[m]).unwrap();
+        assert_ne!(a.pixels, b.pixels, "fresh noise in every frame");
+        let mean_diff = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(x, y)| (f64::from(*x) - f64::from(*y)).abs())
+            .sum::<f64>()
+            / a.pixels.len() as f64;
+        assert!(
+            mean_diff < 4.0 * cfg.imaging.noise_sigma + 0.5,
+            "{mean_diff}"
+        );
+        assert_eq!(a.truth.len(), b.truth.len());
+        assert_eq!(a.truth[0].corners_px, b.truth[0].corners_px);
+        // Moved by 2 cm: drawn again, where a fresh camera draws it.
+        let moved = MarkerPlacement {
+            centre: [0.52, 0.4],
+            ..m
+        };
+        let c = cam.capture(0.2, &[], &[moved]).unwrap();
+        let fresh = Camera::new(cfg, 9)
+            .unwrap()
+            .capture(0.0, &[], &[moved])
+            .unwrap();
+        assert_eq!(c.truth[0].corners_px, fresh.truth[0].corners_px);
+        let far = c
+            .pixels
+            .iter()
+            .zip(&fresh.pixels)
+            .filter(|(x, y)| (i32::from(**x) - i32::from(**y)).abs() > 60)
+            .count();
+        assert!(
+            far < 20,
+            "{far} pixels differ beyond noise from a fresh drawing"
         );
     }
 
