@@ -31,9 +31,11 @@ pub struct SimArgs {
     /// Camera heading noise (standard deviation), degrees.
     #[arg(long, default_value_t = 0.5)]
     pub noise_deg: f64,
-    /// How far inside the table edge the object's boundary lies, m.
-    #[arg(long, default_value_t = 0.1)]
-    pub boundary_inset: f64,
+    /// How far inside the table edge the object's boundary lies, m [default: 0.1 in simulation,
+    /// whose table gets --table-margin of extra room; 0.2 with --hil, where the table is the
+    /// real one and the robot needs room to get behind an object at the boundary]
+    #[arg(long)]
+    pub boundary_inset: Option<f64>,
     /// Extra simulated table beyond the scene's on every side (room for the robot), m.
     #[arg(long, default_value_t = 0.25)]
     pub table_margin: f64,
@@ -48,7 +50,8 @@ pub struct SimArgs {
 impl SimArgs {
     fn options(&self, seed: u64) -> Result<SimRobotOptions, CliError> {
         let ok = |v: f64| v.is_finite() && v >= 0.0;
-        if !ok(self.noise_mm) || !ok(self.noise_deg) || !ok(self.boundary_inset) {
+        let boundary_inset = self.boundary_inset.unwrap_or(0.1);
+        if !ok(self.noise_mm) || !ok(self.noise_deg) || !ok(boundary_inset) {
             return Err(CliError::bad_input(
                 "noise and boundary inset must be finite and not negative",
             ));
@@ -57,7 +60,7 @@ impl SimArgs {
             seed,
             position_noise: self.noise_mm * 1e-3,
             heading_noise: self.noise_deg.to_radians(),
-            boundary_inset: self.boundary_inset,
+            boundary_inset,
             table_margin: self.table_margin,
             ..SimRobotOptions::default()
         })
@@ -596,8 +599,17 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
             ));
         }
     };
+    let boundary_inset = a
+        .sim
+        .boundary_inset
+        .unwrap_or(LiveOptions::default().boundary_inset);
+    if !(boundary_inset.is_finite() && boundary_inset >= 0.0) {
+        return Err(CliError::bad_input(
+            "the boundary inset must be finite and not negative",
+        ));
+    }
     let opts = LiveOptions {
-        boundary_inset: a.sim.boundary_inset,
+        boundary_inset,
         object: a.object.clone(),
         watchdog_ms: a.watchdog_ms,
         ..LiveOptions::default()

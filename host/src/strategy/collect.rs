@@ -139,20 +139,22 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             .find(|a| reach.contains(at(*a)))
             .unwrap_or(base);
         circle_walk(io, o.position(), radius, push_angle, 0.05, &[])?;
-        // (d) Push towards the object until it is back inside.
+        // (d) Push towards the object until it is back inside; give up this round when two
+        // pushes running did not bring it closer (it slides along the boundary, or is stuck).
         let mut still = 0;
         for _ in 0..30 {
             let o = io.object_pose();
             if target.contains(o.position()) {
                 return Ok(true);
             }
+            let away = distance_outside(&target, o.position());
             let r = io.robot_pose();
             // Aim at the marker, pulled a little towards the table's centre.
             let aim = o.position() + 0.03 * (ws.boundary.centre() - o.position()).normalize();
             let d = aim - r.position();
             face(io, d.y.atan2(d.x), 0.05)?;
             io.forward(0.03)?;
-            if (io.object_pose().position() - o.position()).norm() < epsilon {
+            if distance_outside(&target, io.object_pose().position()) > away - epsilon {
                 still += 1;
                 if still >= 2 {
                     break;
@@ -166,6 +168,13 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
         }
     }
     Ok(ws.boundary.contains(io.object_pose().position()))
+}
+
+/// How far `p` lies outside `r`, m (0 inside).
+fn distance_outside(r: &super::robot_io::Rect, p: Vector2<f64>) -> f64 {
+    let dx = (r.min[0] - p.x).max(p.x - r.max[0]).max(0.0);
+    let dy = (r.min[1] - p.y).max(p.y - r.max[1]).max(0.0);
+    dx.hypot(dy)
 }
 
 fn outside(io: &mut dyn RobotIo) -> bool {
