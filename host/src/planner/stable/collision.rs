@@ -92,7 +92,12 @@ impl Frame {
     /// The frame of a configuration.
     pub fn of(q: &Pose) -> Self {
         let (s, c) = q.theta.sin_cos();
-        Frame { x: q.x, y: q.y, s, c }
+        Frame {
+            x: q.x,
+            y: q.y,
+            s,
+            c,
+        }
     }
 
     /// A local point in the world frame.
@@ -122,7 +127,11 @@ impl Sat {
             normals.push(nrm);
             // The largest projection, not just the edge's own: robust to nearly collinear
             // vertices, and a separating test on it stays exact.
-            offsets.push(hull.iter().map(|v| nrm.dot(v)).fold(f64::NEG_INFINITY, f64::max));
+            offsets.push(
+                hull.iter()
+                    .map(|v| nrm.dot(v))
+                    .fold(f64::NEG_INFINITY, f64::max),
+            );
         }
         Sat {
             pts: hull.to_vec(),
@@ -353,12 +362,15 @@ impl Body {
     /// overlaps or touches an obstacle at the step's end the step is not; else conservative
     /// advancement decides. The answer is the same as [`Body::step_free`]'s.
     pub fn step_free_swept(&self, world: &World, q: &Pose, xi: &V3, sw: &Swept) -> bool {
-        self.step_free_swept_in(world, q, &Frame::of(q), xi, sw)
+        let end = q.integrate(xi);
+        let sc = end.theta.sin_cos();
+        self.step_free_swept_in(world, q, &Frame::of(q), xi, sw, &end, sc)
     }
 
-    /// [`Body::step_free_swept`] given the frame of `q` (shared by all steps from `q`).
-    /// The static tests are exact separating-axis tests on the convex parts, with a bounding
-    /// disk against each obstacle's box first.
+    /// [`Body::step_free_swept`] given the frame of `q` (shared by all steps from `q`), the
+    /// step's end `end` and its `(sin θ, cos θ)`. The static tests are exact separating-axis
+    /// tests on the convex parts, with a bounding disk against each obstacle's box first.
+    #[allow(clippy::too_many_arguments)]
     pub fn step_free_swept_in(
         &self,
         world: &World,
@@ -366,6 +378,8 @@ impl Body {
         f: &Frame,
         xi: &V3,
         sw: &Swept,
+        end: &Pose,
+        (se, ce): (f64, f64),
     ) -> bool {
         let c = f.apply(sw.centre);
         let r2 = sw.radius * sw.radius;
@@ -378,11 +392,13 @@ impl Body {
         if !hit {
             return true;
         }
-        let end = q.integrate(xi);
-        if self.overlaps_at(world, &end) {
-            return false;
-        }
-        if !self.free_at(world, &end) {
+        let fe = Frame {
+            x: end.x,
+            y: end.y,
+            s: se,
+            c: ce,
+        };
+        if self.overlaps_in(world, &fe) || !self.free_at(world, end) {
             return false;
         }
         self.step_free_from(world, q, xi, None)
@@ -390,13 +406,17 @@ impl Body {
 
     /// Whether the body at `q` overlaps or touches an obstacle (exact, no clearance margin).
     pub fn overlaps_at(&self, world: &World, q: &Pose) -> bool {
-        let f = Frame::of(q);
+        self.overlaps_in(world, &Frame::of(q))
+    }
+
+    /// [`Body::overlaps_at`] for the placement `f`.
+    fn overlaps_in(&self, world: &World, f: &Frame) -> bool {
         world.obstacles.iter().any(|o| {
             let b = o.bounds;
-            let dx = (b[0] - q.x).max(q.x - b[2]).max(0.0);
-            let dy = (b[1] - q.y).max(q.y - b[3]).max(0.0);
+            let dx = (b[0] - f.x).max(f.x - b[2]).max(0.0);
+            let dy = (b[1] - f.y).max(f.y - b[3]).max(0.0);
             dx * dx + dy * dy <= self.radius * self.radius
-                && self.sats.iter().any(|part| part.overlaps(&f, &o.sat))
+                && self.sats.iter().any(|part| part.overlaps(f, &o.sat))
         })
     }
 

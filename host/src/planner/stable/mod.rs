@@ -240,8 +240,7 @@ impl Problem {
             let fine_swept = fine_steps.iter().map(|xi| body.swept(xi)).collect();
             let origin = Pose::new(0.0, 0.0, 0.0);
             let deltas: Vec<Pose> = steps.iter().map(|xi| origin.integrate(xi)).collect();
-            let fine_deltas: Vec<Pose> =
-                fine_steps.iter().map(|xi| origin.integrate(xi)).collect();
+            let fine_deltas: Vec<Pose> = fine_steps.iter().map(|xi| origin.integrate(xi)).collect();
             let delta_sc = deltas.iter().map(|d: &Pose| d.theta.sin_cos()).collect();
             let fine_delta_sc = fine_deltas.iter().map(|d| d.theta.sin_cos()).collect();
             contacts.push(ContactModel {

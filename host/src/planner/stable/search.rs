@@ -23,7 +23,6 @@ use crate::mechanics::{V2, V3};
 
 const NONE: u32 = u32::MAX;
 
-
 /// A small multiplicative hasher for the pruning grid's integer keys (SipHash is the search's
 /// bottleneck otherwise).
 #[derive(Default)]
@@ -232,7 +231,15 @@ impl Heuristic {
             all_fine.min(out_and_back.max(mixed(out_and_back)))
         };
         // Round down, less a little for rounding errors: a bound, never more.
-        (n * (1.0 - 1e-9) - 1e-9).ceil().max(0.0) as u32
+        let v = n * (1.0 - 1e-9) - 1e-9;
+        // `v.ceil()` without the libm call (the hot loop's): truncate, then round up.
+        let t = v as i64;
+        let t = if (t as f64) < v {
+            t.saturating_add(1)
+        } else {
+            t
+        };
+        t.clamp(0, i64::from(u32::MAX)) as u32
     }
 
     /// The lower bound on the remaining cost: `a · steps`.
@@ -304,7 +311,11 @@ impl Heuristic {
 enum Curve {
     /// A rotation about `cor` (slider frame); `cor_at_goal` is `cor` rotated by the goal's
     /// heading; `radius = |cor|`.
-    Turn { cor: V2, cor_at_goal: V2, radius: f64 },
+    Turn {
+        cor: V2,
+        cor_at_goal: V2,
+        radius: f64,
+    },
     /// A translation along `dir` (slider frame).
     Line { dir: V2 },
 }
@@ -431,11 +442,17 @@ fn cell(p: &Problem, q: &Pose, contact: u32) -> Key {
         (1.0, 0)
     };
     (
-        (q.x * f / p.params.grid_xy).floor() as i64 + tag,
-        (q.y * f / p.params.grid_xy).floor() as i64,
-        (th * f / p.params.grid_theta).floor() as i64,
+        floor(q.x * f / p.params.grid_xy) + tag,
+        floor(q.y * f / p.params.grid_xy),
+        floor(th * f / p.params.grid_theta),
         contact,
     )
+}
+
+/// `x.floor() as i64` without the libm call: truncate, then round down.
+fn floor(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
 }
 
 /// Cost of a step given the previous step's (contact, control).
@@ -601,6 +618,8 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     continue;
                 }
                 let q2 = n.q.compose(&deltas[k], sc);
+                let (sd, cd) = dsc[k];
+                let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
                 let hs = heur.steps(&q2);
                 let mut f = cost.saturating_add(heur.cost(hs));
                 if f > max_cost {
@@ -609,11 +628,12 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                 if occupied.get(cell(p, &q2, ci as u32)) <= cost {
                     continue;
                 }
-                if !cm.body.step_free_swept_in(&p.world, &n.q, &frame, xi, &swept[k]) {
+                if !cm
+                    .body
+                    .step_free_swept_in(&p.world, &n.q, &frame, xi, &swept[k], &q2, sc2)
+                {
                     continue;
                 }
-                let (sd, cd) = dsc[k];
-                let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
                 if heur.turns(&q2, sc2, ci, k) {
                     f = f.saturating_add(p.params.b);
                     if f > max_cost {
