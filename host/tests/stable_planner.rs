@@ -499,63 +499,6 @@ fn heuristic_is_a_lower_bound_along_found_plans() {
     }
 }
 
-/// The full A* bound — steps and a due control change — never exceeds the cost a found plan
-/// still pays from any configuration along it, for several cost settings on every preset.
-#[test]
-fn control_change_bound_is_a_lower_bound_along_found_plans() {
-    use pushbot::planner::stable::search::step_cost;
-    for name in PRESETS {
-        for (a, b, c) in [
-            (None, None, None),
-            (Some(1), Some(5), Some(Some(0))),
-            (Some(0), Some(1), Some(Some(10))),
-        ] {
-            let p = load_scene(name)
-                .unwrap()
-                .problem(CostOverride { a, b, c })
-                .unwrap();
-            let pl = plan(&p);
-            if !pl.found {
-                continue;
-            }
-            let h = Heuristic::new(&p);
-            // Cost paid by each step, then the cost still due after step i.
-            let mut prev = p.start_contact.map(|c| (c, usize::MAX));
-            let mut paid = Vec::new();
-            for s in &pl.steps {
-                paid.push(step_cost(&p, prev, s.contact, s.control).unwrap());
-                prev = Some((s.contact, s.control));
-            }
-            assert_eq!(paid.iter().sum::<u32>(), pl.cost, "{name}");
-            let mut turned = 0;
-            for (i, s) in pl.steps.iter().enumerate() {
-                let due: u32 = paid[i + 1..].iter().sum();
-                let bound = h.bound(&s.to, s.to.theta.sin_cos(), Some((s.contact, s.control)));
-                assert!(
-                    bound <= due,
-                    "{name} {a:?} {b:?} {c:?}: step {i}: bound {bound} > {due}"
-                );
-                turned += usize::from(h.turns(&s.to, s.to.theta.sin_cos(), s.contact, s.control));
-            }
-            // Not trivial: some configurations along the plan are off their control's curve,
-            // and the last one is on it.
-            let last = pl.steps.last().unwrap();
-            assert!(!h.turns(
-                &last.to,
-                last.to.theta.sin_cos(),
-                last.contact,
-                last.control
-            ));
-            if pl.control_changes > 0 {
-                assert!(
-                    turned > 0,
-                    "{name}: the bound never sees a due control change"
-                );
-            }
-        }
-    }
-}
-
 /// The precomputed swept-shape test gives the same answer as conservative advancement, for
 /// steps of every control from configurations scattered over the table (many near obstacles).
 #[test]

@@ -19,7 +19,7 @@ use std::time::Instant;
 use super::collision::Frame;
 use super::transit::{TransitPath, transit};
 use super::{Pose, Problem};
-use crate::mechanics::{V2, V3};
+use crate::mechanics::V3;
 
 const NONE: u32 = u32::MAX;
 
@@ -123,19 +123,15 @@ struct Node {
 /// at least that far away). Steps that start within `fine_radius` of the goal are `fine_factor`
 /// times shorter (§4.5): after the last step that starts outside that disk the centre is still
 /// at least `fine_radius − step` from the goal, and the goal box lies within `goal_xy·√2` of it.
+/// Fine steps also turn `fine_factor` times less, so the turning still to do is bounded with
+/// the same split into fine and coarse steps (see [`Heuristic::steps`]).
 ///
-/// A second term bounds the control changes: a configuration reached with control `k` of a
-/// contact reaches the goal neighbourhood without another control change only along the
-/// curve that repeating `k` traces (a circle about the control's fixed rotation centre, or a
-/// ray; refined steps near the goal follow the same curve). If that curve never enters the
-/// neighbourhood, at least one more control change, costing `b`, is due ([`Heuristic::turns`]).
-/// Steps and control changes are separate terms of the cost, so the sum is still a bound.
+/// (A bound on control changes — "this control's curve misses the goal, so a change costing
+/// `b` is due" — is admissible too, but it reorders the search enough that the grid pruning of
+/// §4.2.3 loses Fig. 13's plan for the differential drive, so it is not used.)
 #[derive(Debug, Clone)]
 pub struct Heuristic {
     a: u32,
-    b: u32,
-    /// Per contact, per control: its curve in the slider frame.
-    curves: Vec<Vec<Curve>>,
     step: f64,
     fine_step: f64,
     fine_radius: f64,
@@ -165,30 +161,8 @@ impl Heuristic {
             0.0
         };
         let half_len = p.slider.length() / 2.0;
-        let (sg, cg) = p.goal.theta.sin_cos();
-        let curves = p
-            .contacts
-            .iter()
-            .map(|cm| {
-                cm.steps
-                    .iter()
-                    .map(|xi| match super::cor_of(xi) {
-                        Some(c) => Curve::Turn {
-                            cor: c,
-                            cor_at_goal: V2::new(cg * c.x - sg * c.y, sg * c.x + cg * c.y),
-                            radius: c.norm(),
-                        },
-                        None => Curve::Line {
-                            dir: V2::new(xi.x, xi.y),
-                        },
-                    })
-                    .collect()
-            })
-            .collect();
         Heuristic {
             a: pa.a,
-            b: pa.b,
-            curves,
             step: pa.step,
             fine_step,
             fine_radius,
@@ -246,78 +220,6 @@ impl Heuristic {
     pub fn cost(&self, steps: u32) -> u32 {
         self.a.saturating_mul(steps)
     }
-
-    /// Whether a configuration `q` (with `(sin θ, cos θ)` = `sc`) reached with control
-    /// `control` of contact `contact` needs at least one more control change: repeating the
-    /// control traces a curve that never enters the goal neighbourhood (tested with a margin,
-    /// so it errs towards `false`).
-    pub fn turns(&self, q: &Pose, (s, c): (f64, f64), contact: usize, control: usize) -> bool {
-        const EPS: f64 = 1e-9;
-        let Some(curve) = self.curves.get(contact).and_then(|v| v.get(control)) else {
-            return false;
-        };
-        let (gx, gy, r) = (self.goal.x, self.goal.y, self.goal_xy);
-        match *curve {
-            Curve::Turn {
-                cor,
-                cor_at_goal,
-                radius,
-            } => {
-                // On the circle about the world rotation centre `q.apply(cor)`, the pose with
-                // the goal's heading is `m = q + R(θ)·cor − R(θ_goal)·cor`; poses with a
-                // heading within `goal_theta` of it lie within `radius·goal_theta` of `m`.
-                let mx = q.x + c * cor.x - s * cor.y - cor_at_goal.x;
-                let my = q.y + s * cor.x + c * cor.y - cor_at_goal.y;
-                let dx = ((mx - gx).abs() - r).max(0.0);
-                let dy = ((my - gy).abs() - r).max(0.0);
-                let tol = radius * self.goal_theta + EPS;
-                dx * dx + dy * dy > tol * tol
-            }
-            Curve::Line { dir } => {
-                if super::angle_diff(q.theta, self.goal.theta).abs() > self.goal_theta + EPS {
-                    return true;
-                }
-                // Slab test of the ray `q + t·d`, t ≥ 0, against the goal box.
-                let d = V2::new(c * dir.x - s * dir.y, s * dir.x + c * dir.y);
-                let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-                for (o, d, g) in [(q.x, d.x, gx), (q.y, d.y, gy)] {
-                    let (lo, hi) = (g - r - EPS, g + r + EPS);
-                    if d.abs() < 1e-15 {
-                        if o < lo || o > hi {
-                            return true;
-                        }
-                    } else {
-                        let (a, b) = ((lo - o) / d, (hi - o) / d);
-                        t0 = t0.max(a.min(b));
-                        t1 = t1.min(a.max(b));
-                    }
-                }
-                t0 > t1
-            }
-        }
-    }
-
-    /// The lower bound on the remaining cost of a configuration reached with `control` of
-    /// `contact` (`None`: no control yet): `a · steps + b · [turns]`.
-    pub fn bound(&self, q: &Pose, sc: (f64, f64), last: Option<(usize, usize)>) -> u32 {
-        let turn = last.is_some_and(|(ci, k)| self.turns(q, sc, ci, k));
-        self.cost(self.steps(q))
-            .saturating_add(if turn { self.b } else { 0 })
-    }
-}
-
-/// The curve a control traces when repeated.
-#[derive(Debug, Clone, Copy)]
-enum Curve {
-    /// A rotation about `cor` (slider frame); `cor_at_goal` is `cor` rotated by the goal's
-    /// heading; `radius = |cor|`.
-    Turn {
-        cor: V2,
-        cor_at_goal: V2,
-        radius: f64,
-    },
-    /// A translation along `dir` (slider frame).
-    Line { dir: V2 },
 }
 
 /// A cell key: `(x, y, θ, contact)` indices, `x` tagged for refined cells.
@@ -621,7 +523,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                 let (sd, cd) = dsc[k];
                 let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
                 let hs = heur.steps(&q2);
-                let mut f = cost.saturating_add(heur.cost(hs));
+                let f = cost.saturating_add(heur.cost(hs));
                 if f > max_cost {
                     continue;
                 }
@@ -633,12 +535,6 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     .step_free_swept_in(&p.world, &n.q, &frame, xi, &swept[k], &q2, sc2)
                 {
                     continue;
-                }
-                if heur.turns(&q2, sc2, ci, k) {
-                    f = f.saturating_add(p.params.b);
-                    if f > max_cost {
-                        continue;
-                    }
                 }
                 let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
                 nodes.push(Node {
