@@ -1,9 +1,12 @@
-//! Scenes for stable pushing, in a small TOML format, and the built-in presets shaped after
-//! Lynch & Mason (1996) §4.4: Fig. 13 (omnidirectional robot, one edge), Fig. 15 (car-like
-//! robot), Figs. 16 and 17 (robot arm, two edges, costs `a=1 b=5 c=0` and `a=0 b=1 c=10`) and
-//! Fig. 18 (cluttered), with goal regions as in the paper (±25 % / ±10 % of the slider length,
-//! ±2°). The slider is shaped after Fig. 12: a box with one corner cut, pushed on two opposite
-//! edges.
+//! Scenes for stable pushing and the built-in presets shaped after Lynch & Mason (1996) §4.4:
+//! Fig. 13 (omnidirectional robot, one edge), Fig. 15 (car-like robot), Figs. 16 and 17 (robot
+//! arm, two edges, costs `a=1 b=5 c=0` and `a=0 b=1 c=10`) and Fig. 18 (cluttered), with goal
+//! regions as in the paper (±25 % / ±10 % of the slider length, ±2°). The slider is shaped after
+//! Fig. 12: a box with one corner cut, pushed on two opposite edges.
+//!
+//! The presets are scenes of the shared format (`pushbot_sim::Scene`, issue 4) with a
+//! `[stable]` section, read through [`from_shared`]; so are scene files with a `[table]`
+//! section. Files may still use the older stable-only format below (read by [`parse_scene`]):
 //!
 //! ```toml
 //! name = "example"
