@@ -14,6 +14,8 @@
 //!   on a grid of 0.1 m units.
 //! * `lynch-mason-fig12` — a rectangular slider pushed among obstacles to a goal pose.
 //! * `three-boxes` — three 8 cm boxes in a row ahead of the robot (benchmarks, chain pushes).
+//! * `fig13`, `fig15`, `fig16`, `fig17`, `fig18` — Lynch & Mason's stable-pushing problems
+//!   (§4.4), with a `[stable]` section for the host's planner (files in `presets/`).
 
 /// Names of the presets.
 pub const NAMES: &[&str] = &[
@@ -31,6 +33,11 @@ pub const NAMES: &[&str] = &[
     "bsr-d",
     "lynch-mason-fig12",
     "three-boxes",
+    "fig13",
+    "fig15",
+    "fig16",
+    "fig17",
+    "fig18",
 ];
 
 /// The TOML text of a preset.
@@ -66,6 +73,11 @@ pub fn text(name: &str) -> Option<String> {
         "bsr-d" => bsr_d(),
         "lynch-mason-fig12" => LYNCH_MASON.to_owned(),
         "three-boxes" => three_boxes(),
+        "fig13" => include_str!("presets/fig13.toml").to_owned(),
+        "fig15" => include_str!("presets/fig15.toml").to_owned(),
+        "fig16" => include_str!("presets/fig16.toml").to_owned(),
+        "fig17" => include_str!("presets/fig17.toml").to_owned(),
+        "fig18" => include_str!("presets/fig18.toml").to_owned(),
         _ => return None,
     })
 }

@@ -23,6 +23,7 @@ pub const CONTACT_EPS: f64 = 1e-5;
 #[derive(Clone)]
 pub struct Obstacle {
     shape: ConvexPolygon,
+    sat: Sat,
     /// Axis-aligned bounds `[xmin, ymin, xmax, ymax]`.
     pub bounds: [f64; 4],
     /// Vertices (counter-clockwise) for drawing and transit planning.
@@ -58,9 +59,108 @@ impl Obstacle {
         ];
         Some(Obstacle {
             shape,
+            sat: Sat::new(&vertices),
             bounds,
             vertices,
         })
+    }
+}
+
+/// A convex polygon prepared for the separating-axis test: counter-clockwise vertices, the
+/// outward unit normal of each edge and the edge's offset along it (`n·v ≤ offset` inside).
+#[derive(Clone, Debug)]
+struct Sat {
+    pts: Vec<V2>,
+    normals: Vec<V2>,
+    offsets: Vec<f64>,
+}
+
+/// A rigid placement `(x, y, sin θ, cos θ)`: the local frame's origin and rotation.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// Origin x.
+    pub x: f64,
+    /// Origin y.
+    pub y: f64,
+    /// sin θ.
+    pub s: f64,
+    /// cos θ.
+    pub c: f64,
+}
+
+impl Frame {
+    /// The frame of a configuration.
+    pub fn of(q: &Pose) -> Self {
+        let (s, c) = q.theta.sin_cos();
+        Frame {
+            x: q.x,
+            y: q.y,
+            s,
+            c,
+        }
+    }
+
+    /// A local point in the world frame.
+    fn apply(&self, p: V2) -> V2 {
+        V2::new(
+            self.x + self.c * p.x - self.s * p.y,
+            self.y + self.s * p.x + self.c * p.y,
+        )
+    }
+}
+
+impl Sat {
+    /// From the counter-clockwise vertices of a convex polygon (a [`convex_hull`]).
+    fn new(hull: &[V2]) -> Self {
+        let n = hull.len();
+        let mut normals = Vec::with_capacity(n);
+        let mut offsets = Vec::with_capacity(n);
+        for i in 0..n {
+            let (a, b) = (hull[i], hull[(i + 1) % n]);
+            let e = b - a;
+            let len = e.norm();
+            let nrm = if len > 0.0 {
+                V2::new(e.y / len, -e.x / len)
+            } else {
+                V2::zeros()
+            };
+            normals.push(nrm);
+            // The largest projection, not just the edge's own: robust to nearly collinear
+            // vertices, and a separating test on it stays exact.
+            offsets.push(
+                hull.iter()
+                    .map(|v| nrm.dot(v))
+                    .fold(f64::NEG_INFINITY, f64::max),
+            );
+        }
+        Sat {
+            pts: hull.to_vec(),
+            normals,
+            offsets,
+        }
+    }
+
+    /// Whether this polygon, placed by `f`, overlaps `o` (world frame); touching overlaps.
+    /// Exact separating-axis test over the edge normals of both polygons.
+    fn overlaps(&self, f: &Frame, o: &Sat) -> bool {
+        // Axes of the obstacle, in the local frame: separated if every local vertex lies
+        // beyond the obstacle's edge.
+        for (n, &off) in o.normals.iter().zip(&o.offsets) {
+            let nl = V2::new(f.c * n.x + f.s * n.y, -f.s * n.x + f.c * n.y);
+            let off_l = off - (n.x * f.x + n.y * f.y);
+            if self.pts.iter().all(|p| nl.dot(p) > off_l) {
+                return false;
+            }
+        }
+        // Axes of this polygon, in the world frame.
+        for (n, &off) in self.normals.iter().zip(&self.offsets) {
+            let nw = V2::new(f.c * n.x - f.s * n.y, f.s * n.x + f.c * n.y);
+            let off_w = off + (nw.x * f.x + nw.y * f.y);
+            if o.pts.iter().all(|p| nw.dot(p) > off_w) {
+                return false;
+            }
+        }
+        true
     }
 }
 
@@ -114,7 +214,7 @@ const SWEPT_SAMPLE_ANGLE: f64 = 0.1;
 /// replaces the sweep when it misses.
 #[derive(Clone)]
 pub struct Swept {
-    parts: Vec<ConvexPolygon>,
+    parts: Vec<Sat>,
     /// Centre of a disk holding all parts (slider frame).
     pub centre: V2,
     /// Radius of that disk.
@@ -134,6 +234,8 @@ impl std::fmt::Debug for Swept {
 #[derive(Clone)]
 pub struct Body {
     parts: Vec<ConvexPolygon>,
+    /// The parts' convex hulls for the separating-axis test.
+    sats: Vec<Sat>,
     /// The points of each part (slider frame).
     part_points: Vec<Vec<V2>>,
     /// All vertices of all parts (slider frame).
@@ -156,9 +258,11 @@ impl Body {
         let mut shapes = Vec::new();
         let mut vertices = Vec::new();
         let mut part_points = Vec::new();
+        let mut sats = Vec::new();
         for p in parts {
             if let Some(s) = convex(p) {
                 shapes.push(s);
+                sats.push(Sat::new(&convex_hull(p)));
                 vertices.extend(p.iter().copied());
                 part_points.push(p.clone());
             }
@@ -166,6 +270,7 @@ impl Body {
         let radius = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
         Body {
             parts: shapes,
+            sats,
             part_points,
             vertices,
             radius,
@@ -233,8 +338,8 @@ impl Body {
                 }
             }
             let hull = convex_hull(&cloud);
-            if let Some(shape) = convex(&hull) {
-                parts.push(shape);
+            if convex(&hull).is_some() {
+                parts.push(Sat::new(&hull));
                 all.extend(hull);
             }
         }
@@ -254,35 +359,65 @@ impl Body {
 
     /// As [`Body::step_free`], deciding most steps with one static test of the precomputed
     /// swept shape `sw` of `xi`: if it misses every obstacle the step is free; else if the body
-    /// touches an obstacle at the step's end the step is not; else conservative advancement
-    /// decides. The answer is the same as [`Body::step_free`]'s.
+    /// overlaps or touches an obstacle at the step's end the step is not; else conservative
+    /// advancement decides. The answer is the same as [`Body::step_free`]'s.
     pub fn step_free_swept(&self, world: &World, q: &Pose, xi: &V3, sw: &Swept) -> bool {
-        let c = q.apply(sw.centre);
-        let pose = PPose::new(PVec::new(q.x, q.y), q.theta);
-        let mut hit = false;
-        'obstacles: for o in &world.obstacles {
+        let end = q.integrate(xi);
+        let sc = end.theta.sin_cos();
+        self.step_free_swept_in(world, q, &Frame::of(q), xi, sw, &end, sc)
+    }
+
+    /// [`Body::step_free_swept`] given the frame of `q` (shared by all steps from `q`), the
+    /// step's end `end` and its `(sin θ, cos θ)`. The static tests are exact separating-axis
+    /// tests on the convex parts, with a bounding disk against each obstacle's box first.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step_free_swept_in(
+        &self,
+        world: &World,
+        q: &Pose,
+        f: &Frame,
+        xi: &V3,
+        sw: &Swept,
+        end: &Pose,
+        (se, ce): (f64, f64),
+    ) -> bool {
+        let c = f.apply(sw.centre);
+        let r2 = sw.radius * sw.radius;
+        let hit = world.obstacles.iter().any(|o| {
             let b = o.bounds;
             let dx = (b[0] - c.x).max(c.x - b[2]).max(0.0);
             let dy = (b[1] - c.y).max(c.y - b[3]).max(0.0);
-            if dx * dx + dy * dy > sw.radius * sw.radius {
-                continue;
-            }
-            for part in &sw.parts {
-                if query::intersection_test(&pose, part, &PPose::identity(), &o.shape)
-                    .map_or(true, |i| i.intersecting)
-                {
-                    hit = true;
-                    break 'obstacles;
-                }
-            }
-        }
+            dx * dx + dy * dy <= r2 && sw.parts.iter().any(|part| part.overlaps(f, &o.sat))
+        });
         if !hit {
             return true;
         }
-        if !self.free_at(world, &q.integrate(xi)) {
+        let fe = Frame {
+            x: end.x,
+            y: end.y,
+            s: se,
+            c: ce,
+        };
+        if self.overlaps_in(world, &fe) || !self.free_at(world, end) {
             return false;
         }
         self.step_free_from(world, q, xi, None)
+    }
+
+    /// Whether the body at `q` overlaps or touches an obstacle (exact, no clearance margin).
+    pub fn overlaps_at(&self, world: &World, q: &Pose) -> bool {
+        self.overlaps_in(world, &Frame::of(q))
+    }
+
+    /// [`Body::overlaps_at`] for the placement `f`.
+    fn overlaps_in(&self, world: &World, f: &Frame) -> bool {
+        world.obstacles.iter().any(|o| {
+            let b = o.bounds;
+            let dx = (b[0] - f.x).max(f.x - b[2]).max(0.0);
+            let dy = (b[1] - f.y).max(f.y - b[3]).max(0.0);
+            dx * dx + dy * dy <= self.radius * self.radius
+                && self.sats.iter().any(|part| part.overlaps(f, &o.sat))
+        })
     }
 
     /// Whether the body is free at `q`.

@@ -166,6 +166,10 @@ pub struct ContactModel {
     pub deltas: Vec<Pose>,
     /// The relative motion of each fine step.
     pub fine_deltas: Vec<Pose>,
+    /// `(sin, cos)` of each step's rotation.
+    pub delta_sc: Vec<(f64, f64)>,
+    /// `(sin, cos)` of each fine step's rotation.
+    pub fine_delta_sc: Vec<(f64, f64)>,
 }
 
 /// A stable-pushing planning problem.
@@ -235,8 +239,10 @@ impl Problem {
             let swept = steps.iter().map(|xi| body.swept(xi)).collect();
             let fine_swept = fine_steps.iter().map(|xi| body.swept(xi)).collect();
             let origin = Pose::new(0.0, 0.0, 0.0);
-            let deltas = steps.iter().map(|xi| origin.integrate(xi)).collect();
-            let fine_deltas = fine_steps.iter().map(|xi| origin.integrate(xi)).collect();
+            let deltas: Vec<Pose> = steps.iter().map(|xi| origin.integrate(xi)).collect();
+            let fine_deltas: Vec<Pose> = fine_steps.iter().map(|xi| origin.integrate(xi)).collect();
+            let delta_sc = deltas.iter().map(|d: &Pose| d.theta.sin_cos()).collect();
+            let fine_delta_sc = fine_deltas.iter().map(|d| d.theta.sin_cos()).collect();
             contacts.push(ContactModel {
                 edge: e,
                 placement,
@@ -249,6 +255,8 @@ impl Problem {
                 fine_swept,
                 deltas,
                 fine_deltas,
+                delta_sc,
+                fine_delta_sc,
             });
         }
         Ok(Problem {

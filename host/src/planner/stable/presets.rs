@@ -1,9 +1,12 @@
-//! Scenes for stable pushing, in a small TOML format, and the built-in presets shaped after
-//! Lynch & Mason (1996) §4.4: Fig. 13 (omnidirectional robot, one edge), Fig. 15 (car-like
-//! robot), Figs. 16 and 17 (robot arm, two edges, costs `a=1 b=5 c=0` and `a=0 b=1 c=10`) and
-//! Fig. 18 (cluttered), with goal regions as in the paper (±25 % / ±10 % of the slider length,
-//! ±2°). The slider is shaped after Fig. 12: a box with one corner cut, pushed on two opposite
-//! edges.
+//! Scenes for stable pushing and the built-in presets shaped after Lynch & Mason (1996) §4.4:
+//! Fig. 13 (omnidirectional robot, one edge), Fig. 15 (car-like robot), Figs. 16 and 17 (robot
+//! arm, two edges, costs `a=1 b=5 c=0` and `a=0 b=1 c=10`) and Fig. 18 (cluttered), with goal
+//! regions as in the paper (±25 % / ±10 % of the slider length, ±2°). The slider is shaped after
+//! Fig. 12: a box with one corner cut, pushed on two opposite edges.
+//!
+//! The presets are scenes of the shared format (`pushbot_sim::Scene`, issue 4) with a
+//! `[stable]` section, read through [`from_shared`]; so are scene files with a `[table]`
+//! section. Files may still use the older stable-only format below (read by [`parse_scene`]):
 //!
 //! ```toml
 //! name = "example"
@@ -173,106 +176,12 @@ impl CostSpec {
     }
 }
 
-/// Names of the built-in presets.
+/// Names of the built-in presets: scenes of `pushbot_sim`'s shared format with a `[stable]`
+/// section.
 pub const PRESETS: [&str; 5] = ["fig13", "fig15", "fig16", "fig17", "fig18"];
 
 /// The paper's planning times (s) for the presets, in `PRESETS` order (§4.4).
 pub const PAPER_SECONDS: [f64; 5] = [7.0, 1.0, 35.0, 2.0, 43.0];
-
-const SLIDER: &str = r#"
-[[objects]]
-id = "slider"
-polygon = [[0.0, 0.0], [0.20, 0.0], [0.20, 0.10], [0.15, 0.14], [0.0, 0.14]]
-"#;
-
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
-    format!("[[obstacles]]\npolygon = [[{x0}, {y0}], [{x1}, {y0}], [{x1}, {y1}], [{x0}, {y1}]]\n")
-}
-
-const PLANNER: &str = "step_frac = 0.3\ngrid_xy_frac = 1.0\ngrid_theta_deg = 6.0\nfine_radius_frac = 1.0\n\
-fine_factor = 3.0\nmax_cost = 3000\nmax_nodes = 300000\n";
-
-fn preset_text(name: &str) -> Option<String> {
-    // (figure, table, obstacles, start, goal, edges, goal fraction, pusher, (a, b, c))
-    let (fig, table, obstacles, start, goal, edges, frac, pusher, (a, b, c)) = match name {
-        "fig13" => (
-            13,
-            "[2.4, 1.6]",
-            rect(1.0, 0.0, 1.2, 0.8) + &rect(1.6, 1.1, 1.8, 1.6),
-            "[0.4, 0.4, -90.0]",
-            "[2.0, 0.4, -90.0]",
-            "[0]",
-            0.25,
-            "kind = \"omni\"\nwidth = 0.2\ndepth = 0.12\n",
-            (1, 5, "\"inf\""),
-        ),
-        "fig15" => (
-            15,
-            "[2.4, 1.6]",
-            rect(1.1, 0.0, 1.3, 0.6) + &rect(0.0, 1.2, 0.7, 1.6),
-            "[0.4, 0.4, -90.0]",
-            "[2.0, 1.2, -90.0]",
-            "[0]",
-            0.25,
-            "kind = \"car\"\nwidth = 0.2\ndepth = 0.18\naxle_offset = 0.15\nmin_turning_radius = 0.3\n",
-            (1, 5, "\"inf\""),
-        ),
-        "fig16" | "fig17" => (
-            if name == "fig16" { 16 } else { 17 },
-            "[1.2, 0.8]",
-            rect(0.0, 0.45, 0.5, 0.8) + &rect(0.85, 0.45, 1.2, 0.8),
-            "[0.25, 0.2, 0.0]",
-            "[0.675, 0.62, 90.0]",
-            "[0, 3]",
-            0.1,
-            "kind = \"arm\"\n",
-            if name == "fig16" {
-                (1, 5, "0")
-            } else {
-                (0, 1, "10")
-            },
-        ),
-        "fig18" => (
-            18,
-            "[1.6, 1.2]",
-            rect(0.45, 0.0, 0.6, 0.5)
-                + &rect(0.45, 0.85, 0.6, 1.2)
-                + &rect(0.9, 0.4, 1.05, 1.2)
-                + &rect(1.35, 0.0, 1.6, 0.25)
-                + &rect(0.15, 0.85, 0.3, 1.0)
-                + &rect(1.3, 1.05, 1.45, 1.2),
-            "[0.2, 0.25, 90.0]",
-            "[1.3, 0.9, 0.0]",
-            "[0, 3]",
-            0.1,
-            "kind = \"arm\"\n",
-            (0, 1, "10"),
-        ),
-        _ => return None,
-    };
-    Some(format!(
-        r#"name = "{name}"
-description = "Shaped after Lynch & Mason Fig. {fig}: edges {edges}, goal ±{pct} % of the slider length and ±2°, cost a={a} b={b} c={}."
-table = {table}
-mu = 0.5
-{obstacles}{SLIDER}
-[task]
-object = "slider"
-start = {start}
-goal = {goal}
-edges = {edges}
-goal_xy_frac = {frac}
-goal_theta_deg = 2.0
-[pusher]
-{pusher}[planner]
-a = {a}
-b = {b}
-c = {c}
-{PLANNER}"#,
-        c.trim_matches('"'),
-        pct = frac * 100.0
-    ))
-}
 
 /// Parse a scene from TOML text. Errors name the line (syntax, types) or the field (values).
 pub fn parse_scene(text: &str) -> anyhow::Result<Scene> {
@@ -283,8 +192,9 @@ pub fn parse_scene(text: &str) -> anyhow::Result<Scene> {
 
 /// Load a scene by preset name or from a TOML file.
 pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
-    if let Some(t) = preset_text(name_or_path) {
-        return parse_scene(&t).with_context(|| format!("preset {name_or_path}"));
+    if PRESETS.contains(&name_or_path) {
+        let shared = pushbot_sim::Scene::preset(name_or_path).map_err(|e| anyhow!("{e}"))?;
+        return from_shared(&shared).with_context(|| format!("preset {name_or_path}"));
     }
     let text = std::fs::read_to_string(name_or_path).with_context(|| {
         format!(

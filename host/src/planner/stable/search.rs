@@ -16,6 +16,7 @@ use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
+use super::collision::Frame;
 use super::transit::{TransitPath, transit};
 use super::{Pose, Problem};
 use crate::mechanics::V3;
@@ -122,7 +123,13 @@ struct Node {
 /// at least that far away). Steps that start within `fine_radius` of the goal are `fine_factor`
 /// times shorter (§4.5): after the last step that starts outside that disk the centre is still
 /// at least `fine_radius − step` from the goal, and the goal box lies within `goal_xy·√2` of it.
-#[derive(Debug, Clone, Copy)]
+/// Fine steps also turn `fine_factor` times less, so the turning still to do is bounded with
+/// the same split into fine and coarse steps (see [`Heuristic::steps`]).
+///
+/// (A bound on control changes — "this control's curve misses the goal, so a change costing
+/// `b` is due" — is admissible too, but it reorders the search enough that the grid pruning of
+/// §4.2.3 loses Fig. 13's plan for the differential drive, so it is not used.)
+#[derive(Debug, Clone)]
 pub struct Heuristic {
     a: u32,
     step: f64,
@@ -172,25 +179,41 @@ impl Heuristic {
     }
 
     /// A lower bound on the number of push steps from `q` to the goal neighbourhood.
+    ///
+    /// Distance and turning are bounded together per case: inside the refined disk either
+    /// every remaining step is fine (`fine_factor` times shorter, turning that much less), or
+    /// the path leaves the disk and comes back, which takes at least `A` fine steps (out and
+    /// the tail in) and the rest of the turning at the coarse rate; outside the disk the
+    /// path ends with at least the fine tail.
     pub fn steps(&self, q: &Pose) -> u32 {
         let (dx, dy) = ((q.x - self.goal.x).abs(), (q.y - self.goal.y).abs());
         let (bx, by) = ((dx - self.goal_xy).max(0.0), (dy - self.goal_xy).max(0.0));
         let d_box = (bx * bx + by * by).sqrt();
         let d_centre = (dx * dx + dy * dy).sqrt();
-        let n_dist = if self.fine_radius <= 0.0 {
-            d_box / self.step
+        let turn = (super::angle_diff(q.theta, self.goal.theta).abs() - self.goal_theta).max(0.0);
+        let turn_fine = self.turn * self.fine_step / self.step;
+        // Steps when `n_f` of them are fine and the rest of the turning is coarse.
+        let mixed = |n_f: f64| n_f + ((turn - n_f * turn_fine) / self.turn).max(0.0);
+        let n = if self.fine_radius <= 0.0 {
+            (d_box / self.step).max(turn / self.turn)
         } else if d_centre > self.fine_radius {
             let tail = self.fine_tail;
-            tail + ((d_box - tail * self.fine_step) / self.step).max(0.0)
+            (tail + ((d_box - tail * self.fine_step) / self.step).max(0.0)).max(mixed(tail))
         } else {
-            // Either all remaining steps are fine, or the path leaves the disk and comes back.
-            (d_box / self.fine_step)
-                .min((self.fine_radius - d_centre) / self.fine_step + self.fine_tail)
+            let all_fine = (d_box / self.fine_step).max(turn / turn_fine);
+            let out_and_back = (self.fine_radius - d_centre) / self.fine_step + self.fine_tail;
+            all_fine.min(out_and_back.max(mixed(out_and_back)))
         };
-        let turn = (super::angle_diff(q.theta, self.goal.theta).abs() - self.goal_theta).max(0.0);
-        let n_turn = turn / self.turn;
         // Round down, less a little for rounding errors: a bound, never more.
-        (n_dist.max(n_turn) * (1.0 - 1e-9) - 1e-9).ceil().max(0.0) as u32
+        let v = n * (1.0 - 1e-9) - 1e-9;
+        // `v.ceil()` without the libm call (the hot loop's): truncate, then round up.
+        let t = v as i64;
+        let t = if (t as f64) < v {
+            t.saturating_add(1)
+        } else {
+            t
+        };
+        t.clamp(0, i64::from(u32::MAX)) as u32
     }
 
     /// The lower bound on the remaining cost: `a · steps`.
@@ -321,11 +344,17 @@ fn cell(p: &Problem, q: &Pose, contact: u32) -> Key {
         (1.0, 0)
     };
     (
-        (q.x * f / p.params.grid_xy).floor() as i64 + tag,
-        (q.y * f / p.params.grid_xy).floor() as i64,
-        (th * f / p.params.grid_theta).floor() as i64,
+        floor(q.x * f / p.params.grid_xy) + tag,
+        floor(q.y * f / p.params.grid_xy),
+        floor(th * f / p.params.grid_theta),
         contact,
     )
+}
+
+/// `x.floor() as i64` without the libm call: truncate, then round down.
+fn floor(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
 }
 
 /// Cost of a step given the previous step's (contact, control).
@@ -469,8 +498,19 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
             },
         ));
         let sc = n.q.theta.sin_cos();
+        let frame = Frame {
+            x: n.q.x,
+            y: n.q.y,
+            s: sc.0,
+            c: sc.1,
+        };
         for (ci, cm) in p.contacts.iter().enumerate() {
             let (steps, swept, deltas) = p.steps_swept_at(ci, &n.q);
+            let dsc = if p.near_goal(&n.q) {
+                &cm.fine_delta_sc
+            } else {
+                &cm.delta_sc
+            };
             for (k, xi) in steps.iter().enumerate() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
@@ -480,6 +520,8 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     continue;
                 }
                 let q2 = n.q.compose(&deltas[k], sc);
+                let (sd, cd) = dsc[k];
+                let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
                 let hs = heur.steps(&q2);
                 let f = cost.saturating_add(heur.cost(hs));
                 if f > max_cost {
@@ -488,7 +530,10 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                 if occupied.get(cell(p, &q2, ci as u32)) <= cost {
                     continue;
                 }
-                if !cm.body.step_free_swept(&p.world, &n.q, xi, &swept[k]) {
+                if !cm
+                    .body
+                    .step_free_swept_in(&p.world, &n.q, &frame, xi, &swept[k], &q2, sc2)
+                {
                     continue;
                 }
                 let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
