@@ -64,44 +64,49 @@ fn accuracy_on_rendered_frames() {
     assert!(hmed <= 0.5, "heading median {hmed}°");
 }
 
-/// The kornia candidate reads the same frames with the same corner convention (a wrong corner
-/// order would show as a 90° heading error or a corner error of tens of pixels).
+/// The kornia candidate reads the same frames with the same corner convention and pixel
+/// centres, at its defaults and at `threshold_split = 0.5` (a wrong corner order would show as
+/// a 90° heading error or a corner error of tens of pixels, a half-pixel shift as a bias).
 #[cfg(feature = "kornia")]
 #[test]
 fn kornia_candidate_agrees_on_corners() {
     let layout = MarkerLayout::default_table();
     let frames = synth::frames(&layout, 10, 7, &SynthParams::default()).unwrap();
-    let mut det = KorniaDetector::new(
-        &layout.families(),
-        &KorniaConfig {
-            threshold_split: Some(0.5),
-            downscale: None,
-        },
-    )
-    .unwrap();
-    let mut score = DetectionScore::default();
-    for f in &frames {
-        score.add(&det.detect(&f.frame).unwrap(), &f.markers);
+    for threshold_split in [None, Some(0.5)] {
+        let mut det = KorniaDetector::new(
+            &layout.families(),
+            &KorniaConfig {
+                threshold_split,
+                downscale: None,
+            },
+        )
+        .unwrap();
+        let mut score = DetectionScore::default();
+        for f in &frames {
+            score.add(&det.detect(&f.frame).unwrap(), &f.markers);
+        }
+        eprintln!(
+            "kornia {threshold_split:?}: found {}/{}, corner rms {:.3} px, bias {:?}",
+            score.found,
+            score.visible,
+            score.corner_rms(),
+            score.corner_bias
+        );
+        assert!(
+            score.rate() > 0.95,
+            "found {}/{}",
+            score.found,
+            score.visible
+        );
+        assert!(
+            score.corner_rms() < 0.4,
+            "corner rms {}",
+            score.corner_rms()
+        );
+        let [bx, by] = score.corner_bias;
+        assert!(bx.abs() < 0.1 && by.abs() < 0.1, "corner bias {bx} {by}");
+        assert_eq!(score.wrong_ids, 0);
     }
-    eprintln!(
-        "kornia: found {}/{}, corner rms {:.3} px, bias {:?}",
-        score.found,
-        score.visible,
-        score.corner_rms(),
-        score.corner_bias
-    );
-    assert!(
-        score.rate() > 0.8,
-        "found {}/{}",
-        score.found,
-        score.visible
-    );
-    assert!(
-        score.corner_rms() < 1.0,
-        "corner rms {}",
-        score.corner_rms()
-    );
-    assert_eq!(score.wrong_ids, 0);
 }
 
 /// The chosen pipeline (C AprilTag in tracker-guided regions of interest, whole frames every
@@ -150,7 +155,7 @@ fn regions_of_interest_keep_accuracy_on_video() {
     assert!(p99 <= 4.0, "position p99 {p99} mm");
     assert!(hmed <= 0.5, "heading median {hmed}°");
     // 300 frames: whole frames at 0, 15, 30, … (20) and none forced by a miss on this video.
-    assert!(full >= 20 && full <= 30, "whole frames {full}/300");
+    assert!((20..=30).contains(&full), "whole frames {full}/300");
 }
 
 /// When bodies jump between frames (still frames of random poses), every region misses and
@@ -177,8 +182,8 @@ fn regions_of_interest_fall_back_to_whole_frames() {
 }
 
 /// A region's detections are the whole frame's, in the frame's coordinates: the same markers
-/// with the same corners (to within the sub-pixel refinement's noise), for the C detector's own
-/// region path and for the trait's default (copy the region out).
+/// with the same corners (to within the sub-pixel refinement's noise); the C detector's own
+/// region path gives exactly what the trait's default (copy the region out) gives.
 #[test]
 fn region_detection_matches_whole_frame() {
     let layout = MarkerLayout::default_table();
@@ -199,15 +204,17 @@ fn region_detection_matches_whole_frame() {
                 .into_iter()
                 .map(|d| d.shifted(r.x as f64, r.y as f64))
                 .collect();
-            for found in [&own, &copied] {
-                let d = found
-                    .iter()
-                    .find(|d| d.id == w.id)
-                    .unwrap_or_else(|| panic!("marker {} not found in {r:?}", w.id));
-                for (a, b) in d.corners.iter().zip(&w.corners) {
-                    let e = (a[0] - b[0]).hypot(a[1] - b[1]);
-                    assert!(e < 0.3, "marker {} corner off by {e} px", w.id);
-                }
+            // The C detector's own region path and the copy-out default see the same pixels.
+            assert_eq!(own, copied);
+            let d = own
+                .iter()
+                .find(|d| d.id == w.id)
+                .unwrap_or_else(|| panic!("marker {} not found in {r:?}", w.id));
+            // A wrong offset would be whole pixels; the decimation grid's phase moves corners
+            // by a few tenths at most.
+            for (a, b) in d.corners.iter().zip(&w.corners) {
+                let e = (a[0] - b[0]).hypot(a[1] - b[1]);
+                assert!(e < 0.6, "marker {} corner off by {e} px", w.id);
             }
             checked += 1;
         }

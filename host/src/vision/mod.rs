@@ -9,7 +9,14 @@
 //!   places;
 //! - [`layout`]: which marker is where (until the shared scene format carries it);
 //! - [`tracking`]: a Kalman filter per body;
+//! - [`Pipeline`]: detect → measure → filter per frame; between whole-frame searches it looks
+//!   only in regions around each tracked marker's predicted place ([`RoiParams`]);
 //! - [`synth`] and [`bench`]: rendered test frames with ground truth, and `pushbot bench vision`.
+//!
+//! The choice, measured by `pushbot bench vision` on the same rendered 960×720 frames: the C
+//! detector at `quad_sigma = 1` (as fast as kornia-apriltag at its defaults on whole frames,
+//! with half its corner error, and without the faer build) in tracker-guided regions of
+//! interest, about 2 ms per frame on one core against 30 ms for the reference C settings.
 
 pub mod apriltag;
 pub mod bench;
