@@ -8,7 +8,7 @@ use kornia_apriltag::{AprilTagDecoder, DecodeTagsConfig};
 use kornia_image::{Image, ImageSize};
 use pushbot_sim::camera::MarkerFamily;
 
-use super::detect::{DetectError, Detection, Detector};
+use super::detect::{DetectError, Detection, Detector, Region, check};
 use super::source::Frame;
 
 /// Settings of the kornia detector.
@@ -23,7 +23,8 @@ pub struct KorniaConfig {
 /// The kornia detector.
 pub struct KorniaDetector {
     config: DecodeTagsConfig,
-    decoder: Option<(AprilTagDecoder, ImageSize)>,
+    /// A decoder and an image buffer per frame size in use (whole frames, regions).
+    decoders: Vec<(AprilTagDecoder, Image<u8, 1>)>,
     pool: rayon::ThreadPool,
     families: Vec<MarkerFamily>,
 }
@@ -35,6 +36,9 @@ impl std::fmt::Debug for KorniaDetector {
             .finish()
     }
 }
+
+/// Frame sizes whose decoders are kept.
+const DECODER_CACHE: usize = 8;
 
 fn kind(f: MarkerFamily) -> TagFamilyKind {
     match f {
@@ -63,7 +67,7 @@ impl KorniaDetector {
             .map_err(|e| DetectError::Failed(format!("thread pool: {e}")))?;
         Ok(KorniaDetector {
             config,
-            decoder: None,
+            decoders: Vec::new(),
             pool,
             families: families.to_vec(),
         })
@@ -76,28 +80,31 @@ impl Detector for KorniaDetector {
     }
 
     fn detect(&mut self, frame: &Frame) -> Result<Vec<Detection>, DetectError> {
+        check(frame, &Region::full(frame.width, frame.height))?;
         let size = ImageSize {
             width: frame.width as usize,
             height: frame.height as usize,
         };
-        if frame.pixels.len() != size.width * size.height {
-            return Err(DetectError::Failed(
-                "frame buffer does not match its size".into(),
-            ));
-        }
-        if self.decoder.as_ref().is_none_or(|(_, s)| *s != size) {
-            let d = AprilTagDecoder::new(self.config.clone(), size)
-                .map_err(|e| DetectError::Failed(format!("{e}")))?;
-            self.decoder = Some((d, size));
-        }
-        let Some((decoder, _)) = self.decoder.as_mut() else {
-            return Err(DetectError::Failed("no decoder".into()));
+        let slot = match self.decoders.iter().position(|(_, im)| im.size() == size) {
+            Some(i) => i,
+            None => {
+                let d = AprilTagDecoder::new(self.config.clone(), size)
+                    .map_err(|e| DetectError::Failed(format!("{e}")))?;
+                let im = Image::from_size_val(size, 0u8)
+                    .map_err(|e| DetectError::Failed(format!("{e}")))?;
+                if self.decoders.len() >= DECODER_CACHE {
+                    self.decoders.remove(0);
+                }
+                self.decoders.push((d, im));
+                self.decoders.len() - 1
+            }
         };
-        let image = Image::new(size, frame.pixels.clone())
-            .map_err(|e| DetectError::Failed(format!("{e}")))?;
+        let (decoder, image) = &mut self.decoders[slot];
+        image.as_slice_mut().copy_from_slice(&frame.pixels);
+        decoder.clear();
         let found = self
             .pool
-            .install(|| decoder.decode(&image))
+            .install(|| decoder.decode(image))
             .map_err(|e| DetectError::Failed(format!("{e}")))?;
         let mut out = Vec::with_capacity(found.len());
         for d in found {
@@ -106,11 +113,12 @@ impl Detector for KorniaDetector {
                 TagFamilyKind::Tag25H9 => MarkerFamily::Tag25h9,
                 _ => continue,
             };
-            // Same tag-coordinate convention as the C library (y down the printed tag); kornia's
-            // pixel centres are at integers, ours at integer + 0.5.
+            // Same tag-coordinate convention as the C library (y down the printed tag), and
+            // the same pixel centres (integer + 0.5, measured: adding 0.5 biased every corner
+            // by +0.5 px).
             let p = |x: f32, y: f32| {
                 let q = d.quad.homography_project(x, y);
-                [q.x as f64 + 0.5, q.y as f64 + 0.5]
+                [q.x as f64, q.y as f64]
             };
             out.push(Detection {
                 family,

@@ -90,6 +90,68 @@ pub fn frames(
     seed: u64,
     params: &SynthParams,
 ) -> Result<Vec<SynthFrame>, String> {
+    render(layout, n, seed, params, false)
+}
+
+/// `n` frames of the layout, 1/30 s apart, as a video: every body moves smoothly within its
+/// region of the table (up to about 0.2 m/s and 1.5 rad/s, a pushing robot's pace), so a
+/// tracker can follow it from frame to frame.
+pub fn moving_frames(
+    layout: &MarkerLayout,
+    n: usize,
+    seed: u64,
+    params: &SynthParams,
+) -> Result<Vec<SynthFrame>, String> {
+    render(layout, n, seed, params, true)
+}
+
+/// One body's smooth path within its region: fractions of the region's size and rates.
+#[derive(Debug, Clone, Copy)]
+struct Path {
+    centre: [f64; 2],
+    amplitude: [f64; 2],
+    rate: [f64; 2],
+    phase: [f64; 2],
+    heading: f64,
+    turn: f64,
+}
+
+impl Path {
+    fn random(rng: &mut ChaCha8Rng, size: [f64; 2]) -> Path {
+        // Peak speed a·ω of each axis up to ~0.15 m/s: about 0.2 m/s along a diagonal.
+        let amp = |r: &mut ChaCha8Rng| r.random_range(0.1..0.2);
+        let amplitude = [amp(rng), amp(rng)];
+        let rate =
+            |r: &mut ChaCha8Rng, a: f64, s: f64| r.random_range(0.3..(0.15 / (a * s)).max(0.31));
+        Path {
+            centre: [rng.random_range(0.4..0.6), rng.random_range(0.4..0.6)],
+            amplitude,
+            rate: [
+                rate(rng, amplitude[0], size[0]),
+                rate(rng, amplitude[1], size[1]),
+            ],
+            phase: [rng.random_range(0.0..6.3), rng.random_range(0.0..6.3)],
+            heading: rng.random_range(-3.2..3.2),
+            turn: rng.random_range(-1.5..1.5),
+        }
+    }
+
+    /// Position as fractions of the region, and heading, at time `t`.
+    fn at(&self, t: f64) -> ([f64; 2], f64) {
+        let f = |i: usize| {
+            self.centre[i] + self.amplitude[i] * (self.rate[i] * t + self.phase[i]).sin()
+        };
+        ([f(0), f(1)], wrap_angle(self.heading + self.turn * t))
+    }
+}
+
+fn render(
+    layout: &MarkerLayout,
+    n: usize,
+    seed: u64,
+    params: &SynthParams,
+    moving: bool,
+) -> Result<Vec<SynthFrame>, String> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let model = CameraModel::overhead(layout.table, params.size[0], params.size[1], 16.0)
         .tilted(params.tilt[0], params.tilt[1]);
@@ -100,6 +162,15 @@ pub fn frames(
     let nb = layout.bodies.len().max(1);
     let cols = (nb as f64).sqrt().ceil() as usize;
     let rows = nb.div_ceil(cols);
+    // Keep bodies clear of the calibration markers along the edges.
+    let (x0, x1, y0, y1) = (0.15, tw - 0.15, 0.17, th - 0.17);
+    let (cw, ch) = ((x1 - x0) / cols as f64, (y1 - y0) / rows as f64);
+    // Drawn only for videos, so still frames keep their random stream.
+    let paths: Vec<Path> = if moving {
+        (0..nb).map(|_| Path::random(&mut rng, [cw, ch])).collect()
+    } else {
+        Vec::new()
+    };
     let mut out = Vec::with_capacity(n);
     for k in 0..n {
         let range = |r: [f64; 2], rng: &mut ChaCha8Rng| {
@@ -121,20 +192,22 @@ pub fn frames(
         let mut bodies = Vec::new();
         let mut polys = Vec::new();
         let mut markers: Vec<_> = layout.calibration.iter().map(|m| m.placement()).collect();
-        // Keep bodies clear of the calibration markers along the edges.
-        let (x0, x1, y0, y1) = (0.15, tw - 0.15, 0.17, th - 0.17);
+        let time = k as f64 / 30.0;
         for (i, b) in layout.bodies.iter().enumerate() {
             let (c, r) = (i % cols, i / cols);
-            let cw = (x1 - x0) / cols as f64;
-            let ch = (y1 - y0) / rows as f64;
-            let x = x0 + cw * (c as f64 + rng.random_range(0.3..0.7));
-            let y = y0 + ch * (r as f64 + rng.random_range(0.3..0.7));
-            let pose = Pose::new(x, y, wrap_angle(rng.random_range(-3.2..3.2)));
+            let (f, heading) = if moving {
+                paths[i].at(time)
+            } else {
+                let f = [rng.random_range(0.3..0.7), rng.random_range(0.3..0.7)];
+                (f, wrap_angle(rng.random_range(-3.2..3.2)))
+            };
+            let x = x0 + cw * (c as f64 + f[0]);
+            let y = y0 + ch * (r as f64 + f[1]);
+            let pose = Pose::new(x, y, heading);
             polys.push(body_polygon(&b.body, &pose));
             markers.push(b.placement(&pose));
             bodies.push((b.body.clone(), pose));
         }
-        let time = k as f64 / 30.0;
         let cf = camera
             .capture(time, &polys, &markers)
             .map_err(|e| e.to_string())?;
