@@ -211,7 +211,7 @@ fn collect_once_then_deliver_around_a_wall_from_the_cache() {
     );
     assert!(d.final_distance < 0.022);
     // The global path keeps the object's bounding circle off the wall, and the object really
-    // went around the wall's lower end (x 0.78–0.88 m, y ≥ 0.45 m).
+    // went around the wall's lower end (x 0.78–0.88 m, y ≥ 0.55 m).
     let wall = scene_obstacles(&scene);
     for q in &out.result.path {
         assert!(clearance(Vector2::new(q[0], q[1]), &wall) > 0.07, "{q:?}");
@@ -224,6 +224,6 @@ fn collect_once_then_deliver_around_a_wall_from_the_cache() {
         .map(|(_, o)| o.position())
         .find(|o| (0.78..=0.88).contains(&o.x))
         .expect("the object passed the wall's x");
-    assert!(crossing.y < 0.45, "crossed at {crossing:?}");
+    assert!(crossing.y < 0.55, "crossed at {crossing:?}");
     assert!(out.result.subgoals.len() >= 3, "{:?}", out.result.subgoals);
 }

@@ -63,9 +63,10 @@ pub fn text(name: &str) -> Option<String> {
             "{ kind = \"points\", points = [[0.06, 0.0], [-0.045, 0.025], [-0.045, -0.025]] }",
         ),
         "lau-snake" => lau(name, SNAKE, [0.0, 0.0], 0.1, SUPPORT_UNIFORM),
-        // The irregular object at A behind a wall from the top edge down to y = 0.45 m.
+        // The irregular object at A behind a wall from the top edge down to y = 0.55 m, leaving a
+        // gap of 0.35 m above the boundary of a live run (inset 0.2 m) to push the object through.
         "lau-obstacles" => {
-            lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &obstacle(7.8, 4.5, 8.8, 12.0)
+            lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &obstacle(7.8, 5.5, 8.8, 12.0)
         }
         "bsr-a" => bsr_a(),
         "bsr-b" => bsr_b(),
