@@ -139,7 +139,7 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             .find(|a| reach.contains(at(*a)))
             .unwrap_or(base);
         circle_walk(io, o.position(), radius, push_angle, 0.05, &[])?;
-        // (d) Push towards the object until it is back inside; give up this round when two
+        // (d) Push towards the object until it is back inside; give up this round when six
         // pushes running did not bring it closer (it slides along the boundary, or is stuck).
         let mut still = 0;
         for _ in 0..30 {
@@ -156,7 +156,7 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             io.forward(0.03)?;
             if distance_outside(&target, io.object_pose().position()) > away - epsilon {
                 still += 1;
-                if still >= 2 {
+                if still >= 6 {
                     break;
                 }
             } else {
