@@ -1,6 +1,7 @@
 //! Quasi-static pushing of a slider by a point (or circular) pusher: the ellipsoidal
 //! approximation of the limit surface (Lee & Cutkosky 1991; Lynch, Maekawa & Tanie 1992),
 //! which Lynch & Mason (§3, "the motion of a pushed object") take as the support-friction model.
+//! Distances and the inside test against the outline come from parry (`parry2d-f64`).
 //!
 //! The slider's support friction is summarised by its centre of friction (COF) and the limit
 //! surface `H(f) = (fx² + fy²)/f_max² + m²/m_max² = 1` in the slider frame at the COF, with
@@ -13,6 +14,11 @@
 //! pusher velocity inside it **sticks** (the contact point moves with the pusher; the closed
 //! form is [`sticking_twist`]), outside it the contact **slides** and the force is on the cone
 //! edge nearer the pusher's velocity, scaled so that the normal velocities match.
+
+use parry2d_f64::math::Vector;
+use parry2d_f64::query::PointQuery;
+use parry2d_f64::shape::Polyline;
+use parry2d_f64::utils::point_in_poly2d;
 
 use crate::robot::{Pose, wrap_angle};
 
@@ -176,42 +182,27 @@ fn weighted_centre(pts: &[[f64; 2]], weights: Option<&[f64]>) -> ([f64; 2], f64)
     (cof, c.max(1e-4))
 }
 
-/// Even-odd point-in-polygon test.
-pub fn point_in_polygon(p: [f64; 2], outline: &[[f64; 2]]) -> bool {
-    let n = outline.len();
-    let mut inside = false;
-    for i in 0..n {
-        let (a, b) = (outline[i], outline[(i + 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
-            if p[0] < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
+fn parry_vertices(outline: &[[f64; 2]]) -> Vec<Vector> {
+    outline.iter().map(|v| Vector::new(v[0], v[1])).collect()
 }
 
-/// Closest point on the polygon's boundary to `p`, and the distance.
+/// Whether `p` is inside the simple polygon `outline` (parry's winding-number test).
+pub fn point_in_polygon(p: [f64; 2], outline: &[[f64; 2]]) -> bool {
+    point_in_poly2d(Vector::new(p[0], p[1]), &parry_vertices(outline))
+}
+
+/// Closest point on the polygon's boundary to `p`, and the distance (parry's projection on the
+/// closed polyline of the outline; `p` itself at infinite distance for an empty outline).
 pub fn closest_boundary_point(p: [f64; 2], outline: &[[f64; 2]]) -> ([f64; 2], f64) {
-    let n = outline.len();
-    let mut best = (outline[0], f64::INFINITY);
-    for i in 0..n {
-        let (a, b) = (outline[i], outline[(i + 1) % n]);
-        let ab = [b[0] - a[0], b[1] - a[1]];
-        let len2 = dot(ab, ab);
-        let t = if len2 > 0.0 {
-            (dot([p[0] - a[0], p[1] - a[1]], ab) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
-        let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
-        if d < best.1 {
-            best = (q, d);
-        }
+    let n = outline.len() as u32;
+    if n == 0 {
+        return (p, f64::INFINITY);
     }
-    best
+    let indices = (0..n).map(|i| [i, (i + 1) % n]).collect();
+    let boundary = Polyline::new(parry_vertices(outline), Some(indices));
+    let q = Vector::new(p[0], p[1]);
+    let proj = boundary.project_local_point(q, false);
+    ([proj.point.x, proj.point.y], (proj.point - q).length())
 }
 
 /// A pushable object in the plane: its outline in the object frame, where its COF is, its

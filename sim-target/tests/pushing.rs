@@ -182,3 +182,38 @@ proptest! {
         }
     }
 }
+
+/// parry's boundary projection and inside test against the closed form for a square, and
+/// against dense sampling of the boundary of a non-convex outline.
+#[test]
+fn boundary_distance_and_inside_test() {
+    use pushbot_sim::pushing::{closest_boundary_point, point_in_polygon};
+    let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let (q, d) = closest_boundary_point([0.3, 0.2], &sq);
+    assert!((d - 0.2).abs() < 1e-12 && (q[0] - 0.3).abs() < 1e-12 && q[1].abs() < 1e-12);
+    let (_, d) = closest_boundary_point([2.0, 2.0], &sq);
+    assert!((d - 2f64.sqrt()).abs() < 1e-12);
+    assert!(point_in_polygon([0.5, 0.5], &sq) && !point_in_polygon([1.5, 0.5], &sq));
+    let l = [
+        [0.0, 0.0],
+        [2.0, 0.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 2.0],
+    ];
+    for p in [[1.5, 1.5], [0.5, 0.5], [1.2, 0.9], [-0.5, 3.0], [1.0, 1.0]] {
+        let mut best = f64::INFINITY;
+        for k in 0..l.len() {
+            let (a, b) = (l[k], l[(k + 1) % l.len()]);
+            for s in 0..=2000 {
+                let t = f64::from(s) / 2000.0;
+                let x = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+                best = best.min((x[0] - p[0]).hypot(x[1] - p[1]));
+            }
+        }
+        let (_, d) = closest_boundary_point(p, &l);
+        assert!(d <= best + 1e-12 && best - d < 1e-3, "{p:?}: {d} vs {best}");
+    }
+    assert!(!point_in_polygon([1.5, 1.5], &l) && point_in_polygon([1.2, 0.9], &l));
+}
