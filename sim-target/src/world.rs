@@ -5,7 +5,9 @@
 //! once ([`crate::quasistatic`]): the robot pushes objects quasi-statically (the ellipsoidal
 //! limit surface of Lynch & Mason §3), objects push each other and rest against walls and
 //! obstacles, and the robot's motion is cut back to what the world makes room for, so nothing
-//! ever interpenetrates. Shapes and contact points come from `parry2d` ([`crate::geometry`]).
+//! interpenetrates beyond the step's linearised rotation (a corner at radius r turning by dθ
+//! in one step may overshoot by r·dθ²/2, under a micrometre here). Shapes and contact points
+//! come from `parry2d` ([`crate::geometry`]).
 //! A wheel whose rolling speed no longer matches the body's motion is held by its traction: it
 //! stalls (turns with the body) while the motor torque needed to hold it is within traction,
 //! and otherwise slips, spinning on the table against kinetic friction. A bumper switch closes

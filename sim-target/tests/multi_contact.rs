@@ -239,8 +239,12 @@ proptest! {
         for (l, r) in duties {
             for _ in 0..700 {
                 w.step([l, r], DT);
+                // The solver moves a body along the chord of its rotation within one step,
+                // so a corner at radius r turning by dθ can overshoot a contact by r·dθ²/2:
+                // r ≤ 0.1 m and dθ ≤ 4 rad/s · 1 ms bound that by 8·10⁻⁷ m, under a
+                // micrometre. Found at 3·10⁻⁸ m (seed 742, kept in the regressions file).
                 let p = w.max_penetration();
-                prop_assert!(p < 1e-9, "penetration {}", p);
+                prop_assert!(p < 1e-6, "penetration {}", p);
             }
         }
     }
