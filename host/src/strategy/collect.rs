@@ -236,12 +236,11 @@ pub fn collect(
             rep.boundary_resets += 1;
             reset_robot_obj_boundary(io, margin, params.epsilon)?;
         }
+        // Counters only: asking for a pose here would make a live robot look once more.
         tracing::debug!(
-            "initial collection: {} samples, {} misses, robot {:?}, object {:?}, {:.0} s",
+            "initial collection: {} samples, {} misses, {:.0} s",
             rep.initial_samples,
             rep.misses,
-            io.robot_pose(),
-            io.object_pose(),
             io.time() - t0
         );
         let angle = rng.random_range(-params.spin_max..=params.spin_max);
@@ -275,9 +274,10 @@ pub fn collect(
         }
         let goal = random_goal(io, &mut rng, params.goal_min_distance);
         tracing::debug!(
-            "evaluation query {}: goal {goal:?}, object {:?}, {:.0} s",
+            "evaluation query {}: goal ({:.3}, {:.3}), {:.0} s",
             rep.queries,
-            io.object_pose(),
+            goal.x,
+            goal.y,
             io.time() - t0
         );
         let mut added = 0;
