@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-say() { printf '\n== %s\n' "$*"; }
+# Each stage's heading carries the minutes since the start, so a slow stage shows in CI's log.
+say() { printf '\n== %s (at %dm%02ds)\n' "$*" $((SECONDS / 60)) $((SECONDS % 60)); }
 
 say "installing what the tests need"
 need_pkgs=()
@@ -40,3 +41,4 @@ say "firmware in QEMU"
 PUSHBOT_QEMU_ELF="$PWD/target/boards/thumbv7m-none-eabi/release/pushbot-board-qemu" \
   cargo test -p pushbot-tests --test qemu -- --ignored --nocapture
 echo "qemu: passed"
+say "all passed"

@@ -3,7 +3,7 @@
 
 use indicatif::ProgressBar;
 use nalgebra::Vector2;
-use pushbot::strategy::collect::{CollectParams, collect, reset_robot_obj_boundary};
+use pushbot::strategy::collect::{CollectParams, collect, reset_robot_obj_boundary, safe_spin};
 use pushbot::strategy::deliver::{DeliveryParams, deliver_learned};
 use pushbot::strategy::eval::{Method, TrialSetup, run_start};
 use pushbot::strategy::regression::{KernelParams, PushStrategy};
@@ -226,4 +226,80 @@ fn collect_once_then_deliver_around_a_wall_from_the_cache() {
         .expect("the object passed the wall's x");
     assert!(crossing.y < 0.55, "crossed at {crossing:?}");
     assert!(out.result.subgoals.len() >= 3, "{:?}", out.result.subgoals);
+}
+
+/// The live layout (`pushbot eval delivery --hil`): the robot cannot leave the table, and the
+/// boundary lies 0.2 m inside it.
+fn live_like(scene: Scene, seed: u64) -> SimRobot {
+    SimRobot::new(
+        scene,
+        None,
+        None,
+        SimRobotOptions {
+            seed,
+            table_margin: 0.0,
+            boundary_inset: 0.2,
+            ..SimRobotOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_random_push_towards_the_boundary_is_drawn_again() {
+    use rand::SeedableRng;
+    let mut scene = Scene::preset("lau-irregular").unwrap();
+    // Object 2 cm inside the left boundary, the robot below it heading up and to the left.
+    scene.objects[0].pose = Pose::new(0.22, 0.6, 0.0);
+    scene.robot.start = Pose::new(0.3, 0.45, 1.87);
+    let mut io = live_like(scene, 3);
+    let ws = io.workspace();
+    let params = initial_only(1, 3);
+    let (r, o) = (io.robot_pose(), io.object_pose().position());
+    let end = |a: f64| o + params.push_max * Vector2::new((r.theta + a).cos(), (r.theta + a).sin());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    // Straight ahead would push the marker out: another heading, whose push stays inside.
+    assert!(!ws.boundary.contains(end(0.0)));
+    let a = safe_spin(&mut io, &mut rng, 0.0, &params);
+    assert!(
+        ws.boundary.contains(end(a)),
+        "spin {a} ends at {:?}",
+        end(a)
+    );
+    assert!(a.abs() <= params.spin_max + 1e-12);
+    // A safe draw is kept as drawn (the paper's random pushes are unchanged away from the edge).
+    let safe = -1.0;
+    assert!(ws.boundary.contains(end(safe)));
+    assert_eq!(safe_spin(&mut io, &mut rng, safe, &params), safe);
+}
+
+#[test]
+fn an_object_against_the_edge_is_reported_not_slid_into_the_corner() {
+    let mut scene = Scene::preset("lau-irregular").unwrap();
+    // Object 2 cm from the top edge of the table, where the robot cannot get behind it.
+    scene.objects[0].pose = Pose::new(0.6, 1.12, 0.0);
+    scene.robot.start = Pose::new(0.45, 0.9, 0.5);
+    let mut io = live_like(scene, 4);
+    let before = io.true_object_pose();
+    let back = reset_robot_obj_boundary(&mut io, 0.02, 0.004).unwrap();
+    let after = io.true_object_pose();
+    assert!(!back, "object at {after:?}");
+    assert!(
+        (after.position() - before.position()).norm() < 0.01,
+        "the reset moved the object from {before:?} to {after:?}"
+    );
+    // The collection stops with an error that says where the object is.
+    let mut strat = PushStrategy::new(Vec::new(), KernelParams::default());
+    let err = collect(
+        &mut io,
+        &mut strat,
+        &initial_only(10, 4),
+        &mut |_| Ok(()),
+        &ProgressBar::hidden(),
+    )
+    .unwrap_err();
+    assert!(
+        format!("{err:#}").contains("stuck outside the boundary"),
+        "{err:#}"
+    );
 }

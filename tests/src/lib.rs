@@ -134,3 +134,57 @@ pub fn run_bin(name: &str, args: &[&str]) -> Run {
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     }
 }
+
+/// Send the host's and the simulator's logs to the test's output (shown when a test fails, or
+/// always with `--nocapture`), filtered by `PUSHBOT_LOG` as for `pushbot` (default: warnings).
+pub fn init_logging() {
+    let filter = tracing_subscriber::EnvFilter::try_from_env("PUSHBOT_LOG")
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,pushbot_firmware=error"));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_test_writer()
+        .try_init();
+}
+
+/// A wall-clock limit on a whole test: if the test is still running when it passes, the test
+/// process prints `what` and ends with a failure, so a run that stopped making progress fails
+/// in minutes instead of holding up the suite. Dropping the guard disarms it.
+#[derive(Debug)]
+pub struct WallLimit {
+    done: std::sync::Arc<(std::sync::Mutex<bool>, std::sync::Condvar)>,
+}
+
+impl WallLimit {
+    /// Arm a limit of `limit` wall time for the test `what`.
+    pub fn arm(what: &str, limit: Duration) -> WallLimit {
+        let done = std::sync::Arc::new((std::sync::Mutex::new(false), std::sync::Condvar::new()));
+        let flag = done.clone();
+        let what = what.to_owned();
+        std::thread::spawn(move || {
+            let (lock, cv) = &*flag;
+            let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+            let (guard, _) = cv
+                .wait_timeout_while(guard, limit, |d| !*d)
+                .unwrap_or_else(|e| e.into_inner());
+            if !*guard {
+                use std::io::Write;
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "{what}: still running after {:.0} s of wall time; ending the test process \
+                     (rerun with PUSHBOT_LOG=pushbot=debug --nocapture to see where it was)",
+                    limit.as_secs_f64()
+                );
+                std::process::exit(101);
+            }
+        });
+        WallLimit { done }
+    }
+}
+
+impl Drop for WallLimit {
+    fn drop(&mut self) {
+        let (lock, cv) = &*self.done;
+        *lock.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        cv.notify_all();
+    }
+}

@@ -12,6 +12,12 @@ use pushbot_tests::SIM_SPEED;
 
 #[test]
 fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
+    pushbot_tests::init_logging();
+    // About 20 s; a run that stops making progress fails instead of holding up the suite.
+    let _limit = pushbot_tests::WallLimit::arm(
+        "case_a1_is_executed_over_the_serial_port_with_camera_feedback",
+        std::time::Duration::from_secs(10 * 60),
+    );
     let p = load_scene("A1").expect("preset");
     let model = Model::new(&p).expect("model");
     let map = cost_map(&model).expect("map");

@@ -9,8 +9,14 @@ use pushbot_sim::Scene;
 use pushbot_tests::SIM_SPEED;
 
 #[test]
-
 fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
+    pushbot_tests::init_logging();
+    // About 2.5 min on a 2-core machine; a run that stops making progress fails instead of
+    // holding up the suite.
+    let _limit = pushbot_tests::WallLimit::arm(
+        "collect_and_deliver_one_object_through_the_port_and_the_camera",
+        std::time::Duration::from_secs(15 * 60),
+    );
     let scene = Scene::preset("lau-irregular").expect("preset");
     let goal = scene.goals[0].pose;
     let t = SimTarget::start(&scene, 21, SIM_SPEED, None).expect("start the simulated target");

@@ -12,7 +12,7 @@ use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::{LiveOptions, LiveRobot};
-use crate::strategy::collect::{CollectParams, CollectReport, collect};
+use crate::strategy::collect::{CollectParams, CollectReport, bring_inside, collect};
 use crate::strategy::deliver::{DeliveryParams, deliver_dipole, deliver_learned};
 use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start, summarise};
 use crate::strategy::figures;
@@ -646,6 +646,13 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
     };
     let mut runs = Vec::new();
     for _ in 0..a.trials {
+        // A trial starts with the object inside the boundary (Lau et al. §III-A): push it back
+        // if the collection or the last trial left it outside.
+        bring_inside(
+            &mut io,
+            delivery.bound_all_margin,
+            CollectParams::default().epsilon,
+        )?;
         let d = match method {
             Method::Learned => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), kernel);

@@ -8,6 +8,13 @@
 //! object back in; Fig. 3) when the object left the boundary. Experimental evaluation: solve
 //! random goal queries with the data so far, adding each push as a supplemental sample used at
 //! once, until the last `streak` queries all succeeded.
+//!
+//! Two guards the paper leaves to the person watching the robot: a random push that could carry
+//! the object's marker out of the boundary is drawn again ([`safe_spin`]), and when the object
+//! ends where the robot cannot get behind it (against the table's edge), `reset_robot_obj_boundary`
+//! reports it instead of sliding the object along the edge, and [`bring_inside`] stops the
+//! collection with an error that says where the object is, after [`STUCK_RESETS`] tries. The
+//! collection ends with the object inside the boundary.
 
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -128,20 +135,38 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
         let Some(n) = ws.boundary.outward(o.position()) else {
             return Ok(true);
         };
-        // The push-point, or the reachable point of the circle nearest to it.
+        // The push-point, or the reachable point of the circle nearest to it from which a push
+        // still points inward (within 60° of the boundary's inward normal); none: the object
+        // lies where the robot cannot get behind it, and pushing from further round would only
+        // slide it along the table's edge.
         let base = n.y.atan2(n.x);
         let at = |a: f64| o.position() + radius * Vector2::new(a.cos(), a.sin());
-        let push_angle = (0..=36)
+        let Some(push_angle) = (0..=12)
             .flat_map(|k| {
                 let d = f64::from(k) * 5f64.to_radians();
                 [base + d, base - d]
             })
             .find(|a| reach.contains(at(*a)))
-            .unwrap_or(base);
+        else {
+            tracing::debug!(
+                "boundary reset: no push-point behind the object at ({:.3}, {:.3})",
+                o.x,
+                o.y
+            );
+            return Ok(false);
+        };
+        tracing::debug!(
+            "boundary reset round {_round}: object at ({:.3}, {:.3}), push from {:.0}° (wanted {:.0}°)",
+            o.x,
+            o.y,
+            push_angle.to_degrees(),
+            base.to_degrees()
+        );
         circle_walk(io, o.position(), radius, push_angle, 0.05, &[])?;
         // (d) Push towards the object until it is back inside; give up this round when six
         // pushes running did not bring it closer (it slides along the boundary, or is stuck).
         let mut still = 0;
+        let start = distance_outside(&target, o.position());
         for _ in 0..30 {
             let o = io.object_pose();
             if target.contains(o.position()) {
@@ -154,7 +179,12 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             let d = aim - r.position();
             face(io, d.y.atan2(d.x), 0.05)?;
             io.forward(0.03)?;
-            if distance_outside(&target, io.object_pose().position()) > away - epsilon {
+            let now = distance_outside(&target, io.object_pose().position());
+            if now > start + 0.02 {
+                // Pushed from the side, it slides along the edge and further out: stop.
+                break;
+            }
+            if now > away - epsilon {
                 still += 1;
                 if still >= 6 {
                     break;
@@ -163,11 +193,80 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
                 still = 0;
             }
         }
-        if ws.boundary.contains(io.object_pose().position()) {
+        let o = io.object_pose();
+        tracing::debug!(
+            "boundary reset round {_round} ended: object at ({:.3}, {:.3}), robot at {:?}",
+            o.x,
+            o.y,
+            io.robot_pose()
+        );
+        if ws.boundary.contains(o.position()) {
             return Ok(true);
         }
     }
     Ok(ws.boundary.contains(io.object_pose().position()))
+}
+
+/// `reset_robot_obj_boundary` tries before [`bring_inside`] gives up: the object is then where
+/// the robot cannot push it back (against the table's edge) and needs a hand.
+pub const STUCK_RESETS: usize = 2;
+
+/// Push the object back inside the boundary if it is outside (`reset_robot_obj_boundary`, up to
+/// [`STUCK_RESETS`] times); returns how many resets ran, or an error that says where the object
+/// is stuck.
+pub fn bring_inside(io: &mut dyn RobotIo, margin: f64, epsilon: f64) -> Result<usize> {
+    for tries in 0..STUCK_RESETS {
+        if !outside(io) {
+            return Ok(tries);
+        }
+        if reset_robot_obj_boundary(io, margin, epsilon)? {
+            return Ok(tries + 1);
+        }
+    }
+    Err(stuck(io))
+}
+
+/// The random spin of an initial-collection push: `first` (already drawn), or, when a push of
+/// up to `push_max` along the heading it gives could carry the object's marker out of the
+/// boundary, another draw, up to 16 in all; when none is safe, the one whose push ends deepest
+/// inside. The object never moves further than the robot drives, so a safe heading keeps it in.
+pub fn safe_spin(
+    io: &mut dyn RobotIo,
+    rng: &mut ChaCha8Rng,
+    first: f64,
+    params: &CollectParams,
+) -> f64 {
+    let ws = io.workspace();
+    let (r, o) = (io.robot_pose(), io.object_pose().position());
+    let end = |a: f64| o + params.push_max * Vector2::new((r.theta + a).cos(), (r.theta + a).sin());
+    let mut best = (distance_outside(&ws.boundary, end(first)), first);
+    for _ in 1..16 {
+        if best.0 <= 0.0 || !best.0.is_finite() {
+            break;
+        }
+        let a = rng.random_range(-params.spin_max..=params.spin_max);
+        let d = distance_outside(&ws.boundary, end(a));
+        if d < best.0 {
+            best = (d, a);
+        }
+    }
+    best.1
+}
+
+/// The error [`collect`] stops with when the object cannot be pushed back inside.
+fn stuck(io: &mut dyn RobotIo) -> anyhow::Error {
+    let (o, ws) = (io.object_pose(), io.workspace());
+    anyhow::anyhow!(
+        "the object is stuck outside the boundary at ({:.3}, {:.3}) m, where the robot cannot get \
+         behind it to push it back ({STUCK_RESETS} resets failed; boundary x {:.2}..{:.2}, \
+         y {:.2}..{:.2}): put it back inside and run again (collected samples are kept)",
+        o.x,
+        o.y,
+        ws.boundary.min[0],
+        ws.boundary.max[0],
+        ws.boundary.min[1],
+        ws.boundary.max[1]
+    )
 }
 
 /// How far `p` lies outside `r`, m (0 inside).
@@ -233,8 +332,7 @@ pub fn collect(
             reset_robot(io, params.epsilon)?;
         }
         if outside(io) {
-            rep.boundary_resets += 1;
-            reset_robot_obj_boundary(io, margin, params.epsilon)?;
+            rep.boundary_resets += bring_inside(io, margin, params.epsilon)?;
         }
         // Counters only: asking for a pose here would make a live robot look once more.
         tracing::debug!(
@@ -243,7 +341,8 @@ pub fn collect(
             rep.misses,
             io.time() - t0
         );
-        let angle = rng.random_range(-params.spin_max..=params.spin_max);
+        let first = rng.random_range(-params.spin_max..=params.spin_max);
+        let angle = safe_spin(io, &mut rng, first, params);
         io.spin(angle)?;
         let (r0, o0) = (io.robot_pose(), io.object_pose());
         io.forward(rng.random_range(params.push_min..=params.push_max))?;
@@ -269,8 +368,7 @@ pub fn collect(
             reset_robot(io, params.epsilon)?;
         }
         if outside(io) {
-            rep.boundary_resets += 1;
-            reset_robot_obj_boundary(io, margin, params.epsilon)?;
+            rep.boundary_resets += bring_inside(io, margin, params.epsilon)?;
         }
         let goal = random_goal(io, &mut rng, params.goal_min_distance);
         tracing::debug!(
@@ -302,6 +400,10 @@ pub fn collect(
             rep.streak_reached = true;
             break;
         }
+    }
+    // Leave the object inside the boundary, ready for a delivery.
+    if outside(io) {
+        rep.boundary_resets += bring_inside(io, margin, params.epsilon)?;
     }
     rep.total_samples = strategy.len();
     rep.total_minutes = (io.time() - t0) / 60.0;
