@@ -208,8 +208,10 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
 }
 
 /// `reset_robot_obj_boundary` tries before [`bring_inside`] gives up: the object is then where
-/// the robot cannot push it back (against the table's edge) and needs a hand.
-pub const STUCK_RESETS: usize = 2;
+/// the robot cannot push it back (against the table's edge) and needs a hand. A try that finds
+/// no push-point costs no motion; one whose pushes turn the object instead of bringing it in
+/// (a marker near a corner) is worth repeating from the new pose.
+pub const STUCK_RESETS: usize = 5;
 
 /// Push the object back inside the boundary if it is outside (`reset_robot_obj_boundary`, up to
 /// [`STUCK_RESETS`] times); returns how many resets ran, or an error that says where the object
@@ -259,7 +261,7 @@ fn stuck(io: &mut dyn RobotIo) -> anyhow::Error {
     anyhow::anyhow!(
         "the object is stuck outside the boundary at ({:.3}, {:.3}) m, where the robot cannot get \
          behind it to push it back ({STUCK_RESETS} resets failed; boundary x {:.2}..{:.2}, \
-         y {:.2}..{:.2}): put it back inside and run again (collected samples are kept)",
+         y {:.2}..{:.2}): put it back inside and run again",
         o.x,
         o.y,
         ws.boundary.min[0],
