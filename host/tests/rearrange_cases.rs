@@ -1,7 +1,9 @@
-//! The test cases of Ben-Shahar & Rivlin §V-A as presets: each test checks what the paper's
-//! figure shows, by comparing plans and re-costing them under the other presets' rules.
+//! The test cases of Ben-Shahar & Rivlin §V-A as scene presets (`bsr-a1` … `bsr-d1`, by their
+//! paper names A1 … D1): each test checks what the paper's figure shows, by comparing plans and
+//! re-costing them under the other presets' rules; the optimal costs are checked against a
+//! brute-force search, and scenes written inline use the shared scene format.
 
-use pushbot::planner::rearrange::cases::{CASES, load_scene, parse_scene};
+use pushbot::planner::rearrange::cases::{CASES, load_scene, problem_from_toml};
 use pushbot::planner::rearrange::{
     Config, Dir, Model, MoveKind, Plan, Problem, RestoreError, cost_map, replay_cost, restore,
     solve,
@@ -256,41 +258,188 @@ fn the_map_is_reused_for_new_starts() {
 
 #[test]
 fn every_preset_parses_and_has_a_plan() {
-    for (name, _, _) in CASES {
+    for (name, preset, _) in CASES {
         let (p, _, plan) = plan_of(name);
         assert!(ends_at_goals(&p, &plan), "{name}");
+        // The paper's name and the preset's are the same scene.
+        let q = load_scene(preset).unwrap();
+        assert_eq!((q.grid, q.start, q.movables), (p.grid, p.start, p.movables));
+        assert!(
+            load_scene(&name.to_lowercase()).is_ok(),
+            "{name} in lower case"
+        );
     }
 }
 
+/// Dijkstra over the problem's own configuration graph (the model's neighbours, forward from
+/// the start) to the cheapest configuration in the goal set: the cost map's optimum found
+/// independently of the backward propagation and restoration.
+fn brute_force_cost(model: &Model, start: &Config) -> Option<u32> {
+    use std::cmp::Reverse;
+    use std::collections::{BinaryHeap, HashMap};
+    let p = &model.problem;
+    let s = model.pack(start)?;
+    let mut dist: HashMap<u32, u32> = HashMap::from([(s, 0)]);
+    let mut heap = BinaryHeap::from([Reverse((0u32, s))]);
+    let mut nb = Vec::new();
+    while let Some(Reverse((d, idx))) = heap.pop() {
+        if dist.get(&idx).is_some_and(|&e| e < d) {
+            continue;
+        }
+        let c = model.unpack(idx);
+        let at_goal = c
+            .movables
+            .iter()
+            .zip(&p.goal_movables)
+            .all(|(m, g)| g.is_none_or(|g| g == *m))
+            && p.goal_robot.is_none_or(|g| g == c.robot);
+        if at_goal {
+            return Some(d);
+        }
+        model.neighbours(idx, &mut nb);
+        for st in nb.drain(..) {
+            let nd = d + st.cost;
+            if dist.get(&st.to).is_none_or(|&e| nd < e) {
+                dist.insert(st.to, nd);
+                heap.push(Reverse((nd, st.to)));
+            }
+        }
+    }
+    None
+}
+
 #[test]
-fn malformed_scenes_name_line_and_field() {
-    let base = "map = \"\"\"\n...\n...\n\"\"\"\n[robot]\nat = [0, 0]\n";
-    let e = parse_scene(&format!("{base}[[movable]]\nname = \"a\"\n"), "t")
-        .unwrap_err()
-        .0;
-    assert!(e.contains("line") && e.contains("at"), "{e}");
-    let e = parse_scene(&format!("{base}[[movable]]\nname = \"a\"\nat = [1, 1]\npush = [{{ point = [0, 1], dir = \"Q\" }}]\n"), "t")
-        .unwrap_err()
-        .0;
-    assert!(e.contains("line 10") && e.contains("push.dir"), "{e}");
-    let e = parse_scene("map = \"\"\"\n..\n.?\n\"\"\"\n[robot]\nat = [0, 0]\n", "t")
+fn optimal_costs_match_a_brute_force_search() {
+    for (name, _, _) in CASES {
+        let (p, model, plan) = plan_of(name);
+        assert_eq!(
+            brute_force_cost(&model, &p.start),
+            Some(plan.cost),
+            "{name}: the planner's optimum against Dijkstra"
+        );
+    }
+}
+
+/// A shared-format scene of `w` × `h` cells of 0.1 m with the robot's centre and one box at
+/// cells (grid y down), and a `[rearrange]` section ending in `extra`.
+fn grid_scene(
+    w: i32,
+    h: i32,
+    robot: (i32, i32),
+    at: (i32, i32),
+    goal: (i32, i32),
+    extra: &str,
+) -> String {
+    let c = |(x, y): (i32, i32)| ((x as f64 + 0.5) * 0.1, (h as f64 - y as f64 - 0.5) * 0.1);
+    let (r, a, g) = (c(robot), c(at), c(goal));
+    format!(
+        "name = \"t\"\n[table]\nwidth = {}\nheight = {}\n[robot]\nstart = {{ x = {}, y = {}, theta = 0.0 }}\n\
+         [[objects]]\nid = \"a\"\noutline = [[-0.04, -0.04], [0.04, -0.04], [0.04, 0.04], [-0.04, 0.04]]\n\
+         pose = {{ x = {}, y = {}, theta = 0.0 }}\nmass = 0.2\nsupport_friction = 0.35\npusher_friction = 0.5\n\
+         [[goals]]\nobject = \"a\"\npose = {{ x = {}, y = {}, theta = 0.0 }}\n\
+         [rearrange]\ncell = 0.1\n{extra}",
+        w as f64 / 10.0,
+        h as f64 / 10.0,
+        r.0,
+        r.1,
+        a.0,
+        a.1,
+        g.0,
+        g.1
+    )
+}
+
+#[test]
+fn the_rearrange_section_sets_the_robot_goal_and_the_map() {
+    // A 5 × 3 room; the robot must also end in the bottom-right corner.
+    let base = grid_scene(5, 3, (0, 1), (1, 1), (3, 1), "");
+    let p = problem_from_toml(&base, "t.toml").unwrap();
+    assert_eq!(p.goal_robot, None);
+    let (_, _, free) = solve(&p).unwrap();
+    let free = free.unwrap();
+    let text = base.clone() + "robot_goal = [0.45, 0.05]\n";
+    let p = problem_from_toml(&text, "t.toml").unwrap();
+    assert_eq!(p.goal_robot, Some((4, 2)));
+    let (model, _, plan) = solve(&p).unwrap();
+    let plan = plan.unwrap();
+    assert_eq!(plan.steps.last().unwrap().config.robot, (4, 2));
+    assert!(plan.cost > free.cost, "{} vs {}", plan.cost, free.cost);
+    assert_eq!(brute_force_cost(&model, &p.start), Some(plan.cost));
+    // Rough, very rough and no-leave cells, and a map obstacle.
+    let text = base + "map = \"\"\"\n.,;x.\n.....\n...#.\n\"\"\"\n";
+    let p = problem_from_toml(&text, "t.toml").unwrap();
+    let g = |x, y| *p.grid.get(x, y).unwrap();
+    assert_eq!(
+        (g(1, 0).rough, g(2, 0).rough, g(3, 0).no_leave),
+        (1, 2, true)
+    );
+    assert!(g(3, 2).obstacle && !g(4, 2).obstacle && g(0, 0).rough == 0);
+}
+
+#[test]
+fn malformed_scenes_name_file_line_and_field() {
+    let base = grid_scene(3, 2, (0, 0), (1, 1), (2, 1), "");
+    // A contact mode with a bad direction: the line of the field.
+    let text = format!(
+        "{base}[[rearrange.movable]]\nobject = \"a\"\npush = [{{ point = [0, 1], dir = \"Q\" }}]\n"
+    );
+    let line = text.lines().position(|l| l.starts_with("push = ")).unwrap() + 1;
+    let e = problem_from_toml(&text, "t.toml").unwrap_err().0;
+    assert!(
+        e.contains(&format!("t.toml:{line}")) && e.contains("rearrange.movable[0].push[0].dir"),
+        "{e}"
+    );
+    // An unknown cell in the map.
+    let e = problem_from_toml(&format!("{base}map = \"\"\"\n...\n.?.\n\"\"\"\n"), "t.toml")
         .unwrap_err()
         .0;
     assert!(
-        e.contains("line 1") && e.contains("`map`") && e.contains("row 2 column 2"),
+        e.contains("rearrange.map") && e.contains("row 2 column 2"),
         "{e}"
     );
-    let e = parse_scene(
-        &format!("{base}[[movable]]\nname = \"a\"\nat = [5, 1]\n"),
-        "t",
+    // A map of the wrong size.
+    let e = problem_from_toml(
+        &format!("{base}map = \"\"\"\n....\n....\n\"\"\"\n"),
+        "t.toml",
     )
     .unwrap_err()
     .0;
-    assert!(e.contains("line 9") && e.contains("movable `a`.at"), "{e}");
-    let e = parse_scene(&format!("{base}[rules]\nmax_pushd = 2\n"), "t")
+    assert!(
+        e.contains("rearrange.map") && e.contains("2 rows of 3 cells"),
+        "{e}"
+    );
+    // A robot goal off the grid.
+    let e = problem_from_toml(&format!("{base}robot_goal = [0.5, 0.05]\n"), "t.toml")
         .unwrap_err()
         .0;
-    assert!(e.contains("line 8") && e.contains("max_pushd"), "{e}");
+    assert!(e.contains("rearrange.robot_goal"), "{e}");
+    // A misspelt rule: the line and the key.
+    let text = format!("{base}rules = {{ max_pushd = 2 }}\n");
+    let line = text.lines().count();
+    let e = problem_from_toml(&text, "t.toml").unwrap_err().0;
+    assert!(
+        e.contains(&format!("t.toml:{line}")) && e.contains("max_pushd"),
+        "{e}"
+    );
+    // A movable setting for an object that is not there.
+    let e = problem_from_toml(
+        &format!("{base}[[rearrange.movable]]\nobject = \"nope\"\n"),
+        "t.toml",
+    )
+    .unwrap_err()
+    .0;
+    assert!(
+        e.contains("rearrange.movable[0].object") && e.contains("nope"),
+        "{e}"
+    );
+    // The old grid format (no [table]) is refused by name.
+    let e = problem_from_toml(
+        "map = \"\"\"\n...\n\"\"\"\n[robot]\nat = [0, 0]\n",
+        "old.toml",
+    )
+    .unwrap_err()
+    .0;
+    assert!(e.contains("old.toml") && e.contains("no [table]"), "{e}");
 }
 
 fn pushbot(args: &[&str]) -> (i32, String, String) {
@@ -340,7 +489,7 @@ fn cli_plan_rearrange_exit_codes_and_json() {
     assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
     // a box in a corner cannot be pushed out: no pushing path, exit 1
     let stuck = dir.path().join("stuck.toml");
-    std::fs::write(&stuck, "map = \"\"\"\n....\n....\n\"\"\"\n[robot]\nat = [3, 1]\n[[movable]]\nname = \"a\"\nat = [0, 0]\ngoal = [2, 1]\n").unwrap();
+    std::fs::write(&stuck, grid_scene(4, 2, (3, 1), (0, 0), (2, 1), "")).unwrap();
     let (code, out, _) = pushbot(&[
         "plan",
         "rearrange",
@@ -354,7 +503,15 @@ fn cli_plan_rearrange_exit_codes_and_json() {
     std::fs::write(&bad, "map = 3\n").unwrap();
     let (code, _, err) = pushbot(&["plan", "rearrange", "--scene", bad.to_str().unwrap()]);
     assert_eq!(code, 2);
-    assert!(err.contains("map"), "{err}");
+    assert!(err.contains("bad.toml") && err.contains("[table]"), "{err}");
+    std::fs::write(
+        &bad,
+        grid_scene(4, 2, (3, 1), (0, 0), (2, 1), "").replace("cell = 0.1", "cell = 3"),
+    )
+    .unwrap();
+    let (code, _, err) = pushbot(&["plan", "rearrange", "--scene", bad.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("bad.toml") && err.contains("cell"), "{err}");
     let (code, _, _) = pushbot(&["plan", "rearrange", "--scene", "no-such-scene"]);
     assert_eq!(code, 2);
 }

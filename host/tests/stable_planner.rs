@@ -1,10 +1,15 @@
 //! The stable-pushing planner (Lynch & Mason 1996 §4) on the five presets, each plan checked
 //! step by step by an independent validator; the bucketed OPEN list against a binary heap; and
-//! the planner's optimality claim (§4.3) against an exhaustive search on small instances.
+//! the planner's optimality claim (§4.3) against an exhaustive search on small instances. Scenes
+//! written inline use the shared scene format with a `[stable]` section.
+
+/// The slider of Fig. 12 (a 20 × 14 cm box with one corner cut), its object frame at its area
+/// centroid (the centre of friction of a uniform support).
+const SLIDER: &str = "[[-0.09691358024691357, -0.06790123456790124], [0.10308641975308644, -0.06790123456790124], [0.10308641975308644, 0.03209876543209876], [0.05308641975308642, 0.07209876543209877], [-0.09691358024691357, 0.07209876543209877]]";
 
 use pushbot::mechanics::stable::stable;
 use pushbot::mechanics::{V2, V3, cor};
-use pushbot::planner::stable::presets::{CostOverride, PRESETS, load_scene, parse_scene};
+use pushbot::planner::stable::presets::{CostOverride, PRESETS, load_scene, scene_from_toml};
 use pushbot::planner::stable::pusher::PusherKind;
 use pushbot::planner::stable::search::{Heuristic, Plan, brute_force_cost, exact_goal};
 use pushbot::planner::stable::{Pose, Problem, Queue, angle_diff, plan, plan_with};
@@ -231,39 +236,34 @@ fn dist_to_convex(p: V2, poly: &[V2]) -> f64 {
 /// turning disk clear of the obstacles and the slider between its two straight legs.
 #[test]
 fn mobile_pusher_contact_change_has_a_free_transit_path() {
-    let text = r#"name = "dd"
-table = [1.6, 1.2]
-mu = 0.5
+    let text = format!(
+        r#"name = "dd"
+[table]
+width = 1.6
+height = 1.2
 [[obstacles]]
-polygon = [[0.9, 0.0], [1.1, 0.0], [1.1, 0.5], [0.9, 0.5]]
+outline = [[0.9, 0.0], [1.1, 0.0], [1.1, 0.5], [0.9, 0.5]]
 [[objects]]
 id = "slider"
-polygon = [[0.0, 0.0], [0.20, 0.0], [0.20, 0.10], [0.15, 0.14], [0.0, 0.14]]
-[task]
+outline = {SLIDER}
+pose = {{ x = 0.5, y = 0.4, theta = 0.0 }}
+mass = 0.1
+support_friction = 0.3
+pusher_friction = 0.5
+[[goals]]
 object = "slider"
-start = [0.5, 0.4, 0.0]
-goal = [0.5, 0.3, 0.0]
+pose = {{ x = 0.5, y = 0.3, theta = 0.0 }}
+[stable]
+object = "slider"
 edges = [0, 3]
 start_edge = 0
 goal_xy_frac = 0.1
 goal_theta_deg = 2.0
-[pusher]
-kind = "diff-drive"
-width = 0.12
-depth = 0.1
-axle_offset = 0.05
-plate_width = 0.2
-[planner]
-a = 1
-b = 1
-c = 5
-step_frac = 0.3
-grid_xy_frac = 1.0
-grid_theta_deg = 6.0
-fine_radius_frac = 1.0
-fine_factor = 3.0
-"#;
-    let p = parse_scene(text)
+pusher = {{ kind = "diff-drive", width = 0.12, depth = 0.1, axle_offset = 0.05, plate_width = 0.2 }}
+planner = {{ a = 1, b = 1, c = 5, step_frac = 0.3, grid_xy_frac = 1.0, grid_theta_deg = 6.0, fine_radius_frac = 1.0, fine_factor = 3.0 }}
+"#
+    );
+    let p = scene_from_toml(&text, "dd.toml")
         .unwrap()
         .problem(CostOverride::default())
         .unwrap();
@@ -303,9 +303,9 @@ fine_factor = 3.0
     // must avoid the contact change.
     let walled = text.replace(
         "[[objects]]",
-        "[[obstacles]]\npolygon = [[0.0, 0.56], [1.6, 0.56], [1.6, 0.6], [0.0, 0.6]]\n[[objects]]",
+        "[[obstacles]]\noutline = [[0.0, 0.56], [1.6, 0.56], [1.6, 0.6], [0.0, 0.6]]\n[[objects]]",
     );
-    let p = parse_scene(&walled)
+    let p = scene_from_toml(&walled, "walled.toml")
         .unwrap()
         .problem(CostOverride::default())
         .unwrap();
@@ -322,34 +322,33 @@ fine_factor = 3.0
 fn small(goal: [f64; 3], a: u32, b: u32, c: u32) -> Problem {
     let text = format!(
         r#"name = "small"
-table = [1.0, 1.0]
-mu = 0.5
+[table]
+width = 1.0
+height = 1.0
 [[objects]]
 id = "s"
-polygon = [[0.0, 0.0], [0.20, 0.0], [0.20, 0.10], [0.15, 0.14], [0.0, 0.14]]
-[task]
+outline = {SLIDER}
+pose = {{ x = 0.5, y = 0.5, theta = 0.0 }}
+mass = 0.1
+support_friction = 0.3
+pusher_friction = 0.5
+[[goals]]
 object = "s"
-start = [0.5, 0.5, 0.0]
-goal = [{}, {}, {}]
+pose = {{ x = {}, y = {}, theta = {} }}
+[stable]
+object = "s"
 edges = [0, 3]
 start_edge = 0
 goal_xy_frac = 0.1
 goal_theta_deg = 3.0
-[pusher]
-kind = "arm"
-[planner]
-a = {a}
-b = {b}
-c = {c}
-step_frac = 0.2
-grid_xy_frac = 0.5
-grid_theta_deg = 2.0
-max_cost = 200
-max_nodes = 300000
+pusher = {{ kind = "arm" }}
+planner = {{ a = {a}, b = {b}, c = {c}, step_frac = 0.2, grid_xy_frac = 0.5, grid_theta_deg = 2.0, max_cost = 200, max_nodes = 300000 }}
 "#,
-        goal[0], goal[1], goal[2]
+        goal[0],
+        goal[1],
+        goal[2].to_radians()
     );
-    parse_scene(&text)
+    scene_from_toml(&text, "small.toml")
         .unwrap()
         .problem(CostOverride::default())
         .unwrap()
@@ -406,70 +405,103 @@ fn optimality_against_exhaustive_search() {
 
 #[test]
 fn malformed_scenes_are_clear_errors() {
-    let e = parse_scene("name = \"x\"\ntable = [1.0, 1.0\n")
+    let e = scene_from_toml("name = \"x\"\n[table]\nwidth = [1.0\n", "x.toml")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("line"), "{e}");
-    let good = load_scene("fig17").unwrap();
-    let _ = good;
-    let text = r#"name = "x"
-table = [1.0, 1.0]
-mu = -0.5
-objects = []
-[task]
+    assert!(e.contains("x.toml:3:") || e.contains("x.toml:4:"), "{e}");
+    let text = format!(
+        r#"name = "x"
+[table]
+width = 1.0
+height = 1.0
+[[objects]]
+id = "s"
+outline = {SLIDER}
+pose = {{ x = 0.5, y = 0.5, theta = 0.0 }}
+mass = 0.1
+support_friction = 0.3
+pusher_friction = -0.5
+[[goals]]
 object = "s"
-start = [0.5, 0.5, 0.0]
-goal = [0.5, 0.5, 0.0]
+pose = {{ x = 0.5, y = 0.3, theta = 0.0 }}
+[stable]
+object = "s"
 edges = [0]
 goal_xy_frac = 0.1
 goal_theta_deg = 3.0
-[pusher]
-kind = "arm"
-"#;
-    let e = parse_scene(text).unwrap_err().to_string();
-    assert!(e.contains("mu"), "{e}");
-    let e = parse_scene(&text.replace("mu = -0.5", "mu = 0.5"))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("task.object"), "{e}");
-    let e = parse_scene(&text.replace("kind = \"arm\"", "kind = \"tank\""))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("pusher.kind") || e.contains("mu"), "{e}");
-    let e = parse_scene(&text.replace("mu = -0.5", "mu = 0.5\nbogus = 1"))
-        .unwrap_err()
-        .to_string();
+pusher = {{ kind = "arm" }}
+"#
+    );
+    let fmt = |t: &str| format!("{:#}", scene_from_toml(t, "x.toml").unwrap_err());
+    let e = fmt(&text);
+    assert!(
+        e.contains("x.toml:11") && e.contains("pusher_friction"),
+        "{e}"
+    );
+    let good = text.replace("pusher_friction = -0.5", "pusher_friction = 0.5");
+    assert!(scene_from_toml(&good, "x.toml").is_ok());
+    let e = fmt(&good.replace("object = \"s\"\nedges", "object = \"t\"\nedges"));
+    assert!(e.contains("stable.object"), "{e}");
+    let e = fmt(&good.replace("kind = \"arm\"", "kind = \"tank\""));
+    assert!(
+        e.contains("stable.pusher.kind") && e.contains("tank"),
+        "{e}"
+    );
+    let e = fmt(&good.replace("edges = [0]", "edges = []"));
+    assert!(e.contains("stable.edges"), "{e}");
+    let e = fmt(&good.replace("goal_xy_frac", "bogus = 1\ngoal_xy_frac"));
     assert!(e.contains("bogus"), "{e}");
+    let e = fmt(good.split("[stable]").next().unwrap());
+    assert!(e.contains("[stable]"), "{e}");
+    // The old stable-only format (`table = [w, h]`, [task], [pusher]) is refused by name.
+    let e = fmt("name = \"x\"\ntable = [1.0, 1.0]\nmu = 0.5\n");
+    assert!(
+        e.contains("x.toml") && e.contains("no [table] section"),
+        "{e}"
+    );
     assert!(load_scene("no-such-preset-or-file").is_err());
 }
 
 #[test]
 fn start_in_collision_is_rejected() {
+    // The slider clear of the obstacle, but the robot behind its only pushing edge inside it.
     let text = r#"name = "x"
-table = [1.0, 1.0]
-mu = 0.5
+[table]
+width = 1.0
+height = 1.0
 [[obstacles]]
-polygon = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]]
+outline = [[0.4, 0.3], [0.6, 0.3], [0.6, 0.44], [0.4, 0.44]]
 [[objects]]
 id = "s"
-polygon = [[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]]
-[task]
+outline = [[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]
+pose = { x = 0.5, y = 0.5, theta = 0.0 }
+mass = 0.1
+support_friction = 0.3
+pusher_friction = 0.5
+[[goals]]
 object = "s"
-start = [0.5, 0.5, 0.0]
-goal = [0.2, 0.2, 0.0]
+pose = { x = 0.5, y = 0.8, theta = 0.0 }
+[stable]
+object = "s"
 edges = [0]
 goal_xy_frac = 0.1
 goal_theta_deg = 3.0
-[pusher]
-kind = "arm"
+pusher = { kind = "omni", width = 0.2, depth = 0.12 }
 "#;
-    let e = parse_scene(text)
+    let e = scene_from_toml(text, "x.toml")
         .unwrap()
         .problem(CostOverride::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("task.start"), "{e}");
+    assert!(e.contains("collide") && e.contains("start"), "{e}");
+    // Moved clear, the same scene plans.
+    let clear = text.replace("0.3]", "0.1]").replace("0.44]", "0.2]");
+    let p = scene_from_toml(&clear, "x.toml")
+        .unwrap()
+        .problem(CostOverride::default())
+        .unwrap();
     let _ = Pose::new(0.0, 0.0, 0.0);
+    assert!(plan(&p).found);
 }
 
 /// The A* bound never exceeds the number of steps a found plan still takes (admissibility),
@@ -542,8 +574,8 @@ fn swept_shape_test_agrees_with_conservative_advancement() {
     }
 }
 
-/// A scene in the shared format (`pushbot_sim::Scene`, with a `[stable]` section) gives the
-/// same problem as the stable-format preset it copies: same plan cost and search.
+/// A scene file in the shared format, written out from a preset's planner description, gives
+/// the same problem as the preset: same plan cost and pushes.
 #[test]
 fn shared_format_scene_plans_like_the_preset() {
     let preset = load_scene("fig15").unwrap();

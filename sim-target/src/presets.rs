@@ -12,6 +12,11 @@
 //!   (A: two boxes to move to the other room; B: two boxes to exchange in a corridor; C: a
 //!   complex (U-shaped) movable through a door; D: an L-shaped movable in a cluttered room),
 //!   on a grid of 0.1 m units.
+//! * `bsr-a1` … `bsr-a4`, `bsr-b1`, `bsr-b2`, `bsr-c1`, `bsr-c2`, `bsr-d1` — the exact grids of
+//!   Ben-Shahar & Rivlin's test cases (§V-A, Figs. 9–19) in cells of 0.1 m, with a
+//!   `[rearrange]` section carrying what the grid planner needs beyond the polygons (robot
+//!   size, rough cells, rules, metric, contact modes); the host accepts them as `A1` … `D1`
+//!   too (files in `presets/`).
 //! * `lynch-mason-fig12` — a rectangular slider pushed among obstacles to a goal pose.
 //! * `three-boxes` — three 8 cm boxes in a row ahead of the robot (benchmarks, chain pushes).
 //! * `fig13`, `fig15`, `fig16`, `fig17`, `fig18` — Lynch & Mason's stable-pushing problems
@@ -31,6 +36,15 @@ pub const NAMES: &[&str] = &[
     "bsr-b",
     "bsr-c",
     "bsr-d",
+    "bsr-a1",
+    "bsr-a2",
+    "bsr-a3",
+    "bsr-a4",
+    "bsr-b1",
+    "bsr-b2",
+    "bsr-c1",
+    "bsr-c2",
+    "bsr-d1",
     "lynch-mason-fig12",
     "three-boxes",
     "fig13",
@@ -72,6 +86,15 @@ pub fn text(name: &str) -> Option<String> {
         "bsr-b" => bsr_b(),
         "bsr-c" => bsr_c(),
         "bsr-d" => bsr_d(),
+        "bsr-a1" => include_str!("presets/bsr-a1.toml").to_owned(),
+        "bsr-a2" => include_str!("presets/bsr-a2.toml").to_owned(),
+        "bsr-a3" => include_str!("presets/bsr-a3.toml").to_owned(),
+        "bsr-a4" => include_str!("presets/bsr-a4.toml").to_owned(),
+        "bsr-b1" => include_str!("presets/bsr-b1.toml").to_owned(),
+        "bsr-b2" => include_str!("presets/bsr-b2.toml").to_owned(),
+        "bsr-c1" => include_str!("presets/bsr-c1.toml").to_owned(),
+        "bsr-c2" => include_str!("presets/bsr-c2.toml").to_owned(),
+        "bsr-d1" => include_str!("presets/bsr-d1.toml").to_owned(),
         "lynch-mason-fig12" => LYNCH_MASON.to_owned(),
         "three-boxes" => three_boxes(),
         "fig13" => include_str!("presets/fig13.toml").to_owned(),

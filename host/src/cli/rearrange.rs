@@ -15,7 +15,8 @@ use crate::planner::rearrange::{
 /// Arguments of `pushbot plan rearrange`.
 #[derive(Args, Debug, Clone)]
 pub struct PlanArgs {
-    /// A preset (A1 A2 A3 A4 B1 B2 C1 C2 D1) or a scene file (TOML).
+    /// A case (A1 A2 A3 A4 B1 B2 C1 C2 D1), a scene preset with a `[rearrange]` section, or a
+    /// scene file (TOML, the shared format with `[table]` and `[rearrange]`).
     #[arg(long)]
     pub scene: String,
     /// Write the plan as step-by-step figures (SVG) to this file.

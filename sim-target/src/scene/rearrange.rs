@@ -8,6 +8,7 @@
 //! cell = 0.1                 # m
 //! robot_size = 1             # the robot is a block of cells (default: the smallest that holds it)
 //! robot_mass = 1
+//! robot_goal = [0.55, 0.25]  # optional: where the robot's centre must end (m, table frame)
 //! kg_per_mass = 0.2          # an object of 0.4 kg has mass 2 in the mass metric
 //! # Optional: the paper's exact map, row 0 along the far edge (table y = height), one character
 //! # per cell: '.' free, '#' obstacle, ',' rough, ';' very rough, 'x' no movable may be left.
@@ -42,6 +43,10 @@ pub struct Rearrange {
     /// Weight of the robot's own motion in the mass metric.
     #[serde(default = "one")]
     pub robot_mass: u32,
+    /// Where the robot must end: its centre, m, table frame, rasterised like its start
+    /// (default: anywhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot_goal: Option<[f64; 2]>,
     /// Kilograms per mass unit of the mass metric.
     #[serde(default = "default_kg")]
     pub kg_per_mass: f64,

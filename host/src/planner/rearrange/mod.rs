@@ -7,7 +7,7 @@
 //! - [`metric`]: the cost metrics of §IV-C (mass, safety, passability, contact-mode changes, turns);
 //! - [`costmap`]: the cost mapping phase, §IV-A1 (backward propagation from a goal set);
 //! - [`restore`]: the pushing C-path restoration phase, §IV-A2;
-//! - [`cases`]: the grid scene format and the test cases A–D of §V-A;
+//! - [`cases`]: the test cases A–D of §V-A (scene presets) and reading scenes;
 //! - [`scene`]: the shared scene format (`[rearrange]` section) rasterised to a grid problem;
 //! - [`svg`]: plans drawn as the paper's step-by-step figures;
 //! - [`execute`]: plans carried out by the robot on the table, closed on the camera (§V-B).

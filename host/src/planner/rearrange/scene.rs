@@ -7,7 +7,7 @@
 //! - a cell is an obstacle when any of 3 × 3 points spread over it lies in an obstacle polygon;
 //!   the optional ASCII `map` adds obstacles, rough cells and cells where no movable may be left;
 //! - the robot is a block of `robot_size` cells (default: the fewest that hold its bumper),
-//!   anchored where its centre lies;
+//!   anchored where its centre lies (its start, and its goal if `robot_goal` is given);
 //! - an object's anchor is the cell under its frame's origin, its orientation its heading in
 //!   quarter turns (clockwise = `−π/2`), its shape the cells whose centres its outline covers
 //!   (in its own frame), its goal the scene's goal for it (if any).
@@ -141,7 +141,22 @@ pub fn problem_from_scene(
     }
     let start = scene.robot.start;
     let half = (size - 1) as f64 / 2.0 * c;
-    let robot_at = frame.cell_of(Vector2::new(start.x - half, start.y + half));
+    // The anchor (top-left cell) of the robot's block with its centre at `p`.
+    let anchor = |p: Vector2<f64>| frame.cell_of(Vector2::new(p.x - half, p.y + half));
+    let robot_at = anchor(Vector2::new(start.x, start.y));
+    let goal_robot = match rr.robot_goal {
+        Some([gx, gy]) => {
+            let (x, y) = anchor(Vector2::new(gx, gy));
+            if !(gx.is_finite() && gy.is_finite()) || grid.get(x, y).is_none() {
+                return Err(err(
+                    &[Key("rearrange"), Key("robot_goal")],
+                    format!("[{gx}, {gy}] m is not on the {w} × {h} grid of the table"),
+                ));
+            }
+            Some((x, y))
+        }
+        None => None,
+    };
     let heading = Dir::from_index(quarter_turns(start.theta) as usize);
     let mut movables = Vec::new();
     let mut starts = Vec::new();
@@ -286,7 +301,7 @@ pub fn problem_from_scene(
             pushing: false,
             movables: starts,
         },
-        goal_robot: None,
+        goal_robot,
         goal_movables: goals,
     })
 }
@@ -317,10 +332,15 @@ pub fn rearrange_section(p: &Problem, cell: f64, kg_per_mass: f64) -> Rearrange 
         }
         s
     });
+    let frame = GridFrame { cell, h: p.grid.h };
     Rearrange {
         cell,
         robot_size: Some(p.robot.size as u32),
         robot_mass: p.robot.mass,
+        robot_goal: p.goal_robot.map(|g| {
+            let c = frame.robot_centre(g, p.robot.size);
+            [c.x, c.y]
+        }),
         kg_per_mass,
         map,
         rules: R {

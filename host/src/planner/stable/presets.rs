@@ -4,58 +4,29 @@
 //! regions as in the paper (±25 % / ±10 % of the slider length, ±2°). The slider is shaped after
 //! Fig. 12: a box with one corner cut, pushed on two opposite edges.
 //!
-//! The presets are scenes of the shared format (`pushbot_sim::Scene`, issue 4) with a
-//! `[stable]` section, read through [`from_shared`]; so are scene files with a `[table]`
-//! section. Files may still use the older stable-only format below (read by [`parse_scene`]):
-//!
-//! ```toml
-//! name = "example"
-//! table = [1.2, 0.8]            # width, height (m); the table is (0,w) × (0,h)
-//! mu = 0.5                      # pusher–slider friction coefficient
-//! [[obstacles]]                 # convex polygons, world frame
-//! polygon = [[0.5, 0.0], [0.6, 0.0], [0.6, 0.4], [0.5, 0.4]]
-//! [[objects]]
-//! id = "box"
-//! polygon = [[0, 0], [0.2, 0], [0.2, 0.14], [0, 0.14]]   # object frame
-//! # centre_of_friction = [0.1, 0.07]                    # default: area centroid
-//! [task]
-//! object = "box"
-//! start = [0.2, 0.2, 0.0]       # x, y of the centre of friction, θ in degrees
-//! goal = [1.0, 0.6, 90.0]
-//! edges = [0, 2]                # pushing contacts: edges of the object's polygon
-//! goal_xy_frac = 0.1            # goal half-width in x, y as a fraction of the object length
-//! goal_theta_deg = 2.0
-//! [pusher]
-//! kind = "arm"                  # arm | omni | car | diff-drive
-//! [planner]
-//! a = 1
-//! b = 5
-//! c = 0                         # or "inf": contact changes disallowed
-//! ```
+//! Every scene is one of the shared format (`pushbot_sim::Scene`, issue 4) with a `[stable]`
+//! section (`pushbot_sim::scene::stable`), read through [`from_shared`] into the planner's own
+//! description ([`Scene`]): the presets, and scene files (which need a `[table]`).
 
 use anyhow::{Context, anyhow, bail};
-use serde::Deserialize;
 
 use super::collision::{Obstacle, World};
 use super::pusher::{Pusher, PusherKind};
 use super::{Params, Pose, Problem};
 use crate::mechanics::{Slider, V2, centroid};
 
-/// A stable-pushing scene as written in TOML.
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+/// A stable-pushing task as the planner takes it, from a shared-format scene by [`from_shared`].
+#[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     /// Scene name.
     pub name: String,
     /// Free text.
-    #[serde(default)]
     pub description: String,
     /// Table width and height (m).
     pub table: [f64; 2],
     /// Pusher–slider friction coefficient.
     pub mu: f64,
     /// Convex obstacles (world frame).
-    #[serde(default)]
     pub obstacles: Vec<ObstacleSpec>,
     /// Objects; the task's object is pushed, the others are static obstacles at `pose`.
     pub objects: Vec<ObjectSpec>,
@@ -64,21 +35,18 @@ pub struct Scene {
     /// Who pushes.
     pub pusher: PusherSpec,
     /// Planner settings.
-    #[serde(default)]
     pub planner: PlannerSpec,
 }
 
 /// An obstacle.
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ObstacleSpec {
     /// Vertices of a convex polygon.
     pub polygon: Vec<[f64; 2]>,
 }
 
 /// An object.
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ObjectSpec {
     /// Identifier.
     pub id: String,
@@ -91,8 +59,7 @@ pub struct ObjectSpec {
 }
 
 /// The task.
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TaskSpec {
     /// Id of the object to push.
     pub object: String,
@@ -111,8 +78,7 @@ pub struct TaskSpec {
 }
 
 /// The pusher.
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PusherSpec {
     /// `arm`, `omni`, `car` or `diff-drive`.
     pub kind: String,
@@ -129,8 +95,7 @@ pub struct PusherSpec {
 }
 
 /// Planner settings (all optional).
-#[derive(Debug, Clone, Deserialize, PartialEq, Default)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct PlannerSpec {
     /// Cost per step.
     pub a: Option<u32>,
@@ -156,8 +121,7 @@ pub struct PlannerSpec {
 }
 
 /// A contact-change cost: a number or "inf".
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(untagged)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum CostSpec {
     /// Finite.
     Int(u32),
@@ -171,7 +135,9 @@ impl CostSpec {
         match self {
             CostSpec::Int(v) => Ok(Some(*v)),
             CostSpec::Word(w) if w == "inf" => Ok(None),
-            CostSpec::Word(w) => bail!("planner.c: expected an integer or \"inf\", got {w:?}"),
+            CostSpec::Word(w) => {
+                bail!("stable.planner.c: expected an integer or \"inf\", got {w:?}")
+            }
         }
     }
 }
@@ -183,14 +149,24 @@ pub const PRESETS: [&str; 5] = ["fig13", "fig15", "fig16", "fig17", "fig18"];
 /// The paper's planning times (s) for the presets, in `PRESETS` order (§4.4).
 pub const PAPER_SECONDS: [f64; 5] = [7.0, 1.0, 35.0, 2.0, 43.0];
 
-/// Parse a scene from TOML text. Errors name the line (syntax, types) or the field (values).
-pub fn parse_scene(text: &str) -> anyhow::Result<Scene> {
-    let s: Scene = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
-    validate(&s)?;
-    Ok(s)
+/// The stable-pushing task of a scene's TOML text (the shared format with a `[stable]`
+/// section); `file` names the source in errors, which give its line and field.
+pub fn scene_from_toml(text: &str, file: &str) -> anyhow::Result<Scene> {
+    if let Ok(t) = text.parse::<toml::Table>()
+        && !t.get("table").is_some_and(|v| v.is_table())
+    {
+        bail!(
+            "{file}: not a scene: it has no [table] section (the shared scene format needs \
+             [table], and [stable] for the stable-pushing planner; the old stable-only format \
+             with `table = [w, h]`, [task] and [pusher] is no longer read: see the README's \
+             Scenes section)"
+        );
+    }
+    let shared = pushbot_sim::Scene::from_toml(text, file).map_err(|e| anyhow!("{e}"))?;
+    from_shared(&shared).with_context(|| format!("scene file {file}"))
 }
 
-/// Load a scene by preset name or from a TOML file.
+/// Load a scene by preset name or from a file in the shared scene format.
 pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
     if PRESETS.contains(&name_or_path) {
         let shared = pushbot_sim::Scene::preset(name_or_path).map_err(|e| anyhow!("{e}"))?;
@@ -202,18 +178,7 @@ pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
             PRESETS.join(", ")
         )
     })?;
-    if is_shared_format(&text) {
-        let shared =
-            pushbot_sim::Scene::from_toml(&text, name_or_path).map_err(|e| anyhow!("{e}"))?;
-        return from_shared(&shared).with_context(|| format!("scene file {name_or_path}"));
-    }
-    parse_scene(&text).with_context(|| format!("scene file {name_or_path}"))
-}
-
-/// Whether `text` is in the shared scene format (`[table]` is a table there, an array here).
-fn is_shared_format(text: &str) -> bool {
-    text.parse::<toml::Table>()
-        .is_ok_and(|t| t.get("table").is_some_and(|v| v.is_table()))
+    scene_from_toml(&text, name_or_path)
 }
 
 /// A stable-pushing scene from a scene in the shared format (`pushbot_sim::Scene`) with a
@@ -340,37 +305,40 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
         bail!("table: width and height must be finite and > 0");
     }
     if !(s.mu >= 0.0 && s.mu.is_finite()) {
-        bail!("mu: must be finite and >= 0, got {}", s.mu);
+        bail!(
+            "objects[].pusher_friction (μ): must be finite and >= 0, got {}",
+            s.mu
+        );
     }
     for (i, o) in s.obstacles.iter().enumerate() {
         if o.polygon.len() < 3 || !o.polygon.iter().all(|p| finite(p)) {
-            bail!("obstacles[{i}].polygon: needs at least 3 finite points");
+            bail!("obstacles[{i}].outline: needs at least 3 finite points");
         }
         if Obstacle::new(&pts(&o.polygon)).is_none() {
-            bail!("obstacles[{i}].polygon: degenerate polygon");
+            bail!("obstacles[{i}].outline: degenerate polygon");
         }
     }
     for (i, o) in s.objects.iter().enumerate() {
         if o.polygon.len() < 3 || !o.polygon.iter().all(|p| finite(p)) {
-            bail!("objects[{i}].polygon: needs at least 3 finite points");
+            bail!("objects[{i}].outline: needs at least 3 finite points");
         }
     }
     if !s.objects.iter().any(|o| o.id == s.task.object) {
-        bail!("task.object: no object with id {:?}", s.task.object);
+        bail!("stable.object: no object with id {:?}", s.task.object);
     }
     if !finite(&s.task.start) || !finite(&s.task.goal) {
-        bail!("task.start/goal: must be finite");
+        bail!("the stable object's pose and goal: must be finite");
     }
     if s.task.edges.is_empty() {
-        bail!("task.edges: at least one pushing edge is needed");
+        bail!("stable.edges: at least one pushing edge is needed");
     }
     if let Some(e) = s.task.start_edge
         && !s.task.edges.contains(&e)
     {
-        bail!("task.start_edge: edge {e} is not in task.edges");
+        bail!("stable.start_edge: edge {e} is not in stable.edges");
     }
     if !(s.task.goal_xy_frac > 0.0 && s.task.goal_theta_deg > 0.0) {
-        bail!("task.goal_xy_frac and task.goal_theta_deg: must be > 0");
+        bail!("stable.goal_xy_frac and stable.goal_theta_deg: must be > 0");
     }
     let p = &s.planner;
     for (name, v) in [
@@ -382,7 +350,7 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
         if let Some(v) = v
             && !(v > 0.0 && v.is_finite())
         {
-            bail!("planner.{name}: must be finite and > 0, got {v}");
+            bail!("stable.planner.{name}: must be finite and > 0, got {v}");
         }
     }
     if let Some(c) = &p.c {
@@ -391,17 +359,17 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
     if let Some(v) = p.fine_radius_frac
         && !(v >= 0.0 && v.is_finite())
     {
-        bail!("planner.fine_radius_frac: must be finite and >= 0, got {v}");
+        bail!("stable.planner.fine_radius_frac: must be finite and >= 0, got {v}");
     }
     if p.max_cost.is_some_and(|m| m > 1_000_000) {
-        bail!("planner.max_cost: at most 1000000");
+        bail!("stable.planner.max_cost: at most 1000000");
     }
     match s.pusher.kind.as_str() {
         "arm" | "omni" | "car" | "diff-drive" => {}
-        k => bail!("pusher.kind: expected arm, omni, car or diff-drive, got {k:?}"),
+        k => bail!("stable.pusher.kind: expected arm, omni, car or diff-drive, got {k:?}"),
     }
     if s.pusher.kind == "car" && s.pusher.min_turning_radius.is_none() {
-        bail!("pusher.min_turning_radius: required for a car");
+        bail!("stable.pusher.min_turning_radius: required for a car");
     }
     for (name, v) in [
         ("width", s.pusher.width),
@@ -413,7 +381,7 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
         if let Some(v) = v
             && !(v >= 0.0 && v.is_finite())
         {
-            bail!("pusher.{name}: must be finite and >= 0, got {v}");
+            bail!("stable.pusher.{name}: must be finite and >= 0, got {v}");
         }
     }
     Ok(())
@@ -535,14 +503,14 @@ impl Scene {
             goal,
             params,
         )
-        .map_err(|e| anyhow!("task.edges: {e}"))?;
+        .map_err(|e| anyhow!("stable.edges: {e}"))?;
         problem.start_contact = t
             .start_edge
             .and_then(|e| t.edges.iter().position(|&x| x == e));
         for (i, cm) in problem.contacts.iter().enumerate() {
             if cm.usable.controls.is_empty() {
                 bail!(
-                    "task.edges[{i}]: edge {} has no usable stable push for this pusher",
+                    "stable.edges[{i}]: edge {} has no usable stable push for this pusher",
                     cm.edge
                 );
             }
@@ -553,7 +521,7 @@ impl Scene {
             .any(|cm| cm.body.free_at(&problem.world, &start))
         {
             bail!(
-                "task.start: the slider and pusher collide with an obstacle or wall at the start"
+                "stable: the slider (at its start pose) and the pusher collide with an obstacle or wall"
             );
         }
         Ok(problem)
