@@ -96,7 +96,8 @@ fn learned_delivery_succeeds_from_two_starts_and_dipole_runs_beside_it() {
     for start in ["A", "C"] {
         let (res, runs) = run_start(&setup, Method::Learned, &samples, start, 1).unwrap();
         assert_eq!(res.successes, 1, "{start}: {res:?} {:?}", runs[0]);
-        assert!(runs[0].final_distance < 0.022);
+        // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees within 3σ.
+        assert!(runs[0].final_distance < 0.025, "{:?}", runs[0].final_distance);
         // The object really travelled from its start to the goal.
         let p = setup.scene.position(start).unwrap();
         let straight = (goal - Vector2::new(p.x, p.y)).norm();
@@ -302,4 +303,90 @@ fn an_object_against_the_edge_is_reported_not_slid_into_the_corner() {
         format!("{err:#}").contains("stuck outside the boundary"),
         "{err:#}"
     );
+}
+
+#[test]
+fn a_delivery_started_beside_the_boundary_stays_inside_it() {
+    // A small strategy (the HIL test's 120 pushes) and start C, 5 cm inside the live boundary:
+    // its pushes drift sideways, and without the boundary guard the object leaves the boundary.
+    let scene = Scene::preset("lau-irregular").unwrap();
+    let mut io = live_like(scene.clone(), 8);
+    let mut strat = PushStrategy::new(Vec::new(), KernelParams::default());
+    collect(
+        &mut io,
+        &mut strat,
+        &initial_only(120, 8),
+        &mut |_| Ok(()),
+        &ProgressBar::hidden(),
+    )
+    .unwrap();
+    let samples = strat.samples().to_vec();
+    let setup = |delivery: DeliveryParams| TrialSetup {
+        scene: scene.clone(),
+        object: None,
+        sim: SimRobotOptions {
+            seed: 8,
+            table_margin: 0.0,
+            boundary_inset: 0.2,
+            ..SimRobotOptions::default()
+        },
+        delivery,
+        kernel: KernelParams::default(),
+    };
+    let unguarded = setup(DeliveryParams {
+        boundary_guard: 0.0,
+        ..DeliveryParams::default()
+    });
+    let (res, _) = run_start(&unguarded, Method::Learned, &samples, "C", 6).unwrap();
+    assert!(
+        res.failures
+            .get("object-left-boundary")
+            .copied()
+            .unwrap_or(0)
+            >= 3,
+        "without the guard: {res:?}"
+    );
+    let (res, runs) = run_start(
+        &setup(DeliveryParams::default()),
+        Method::Learned,
+        &samples,
+        "C",
+        6,
+    )
+    .unwrap();
+    assert_eq!(res.successes, 6, "with the guard: {res:?}");
+    // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees within 3σ.
+    let finals: Vec<f64> = runs.iter().map(|d| d.final_distance).collect();
+    assert!(finals.iter().all(|&d| d < 0.022 + 0.003), "{finals:?}");
+}
+
+#[test]
+fn a_boundary_reset_does_not_slide_an_off_centre_marker_along_the_edge() {
+    // The marker near a corner of the object: a push aimed at it turns the object, which then
+    // slides along the boundary instead of going back in. Each round of the reset stops once the
+    // object has slid `SLIDE_LIMIT` (5 cm) along the edge, so it stays where the robot can get
+    // behind it. Without that limit, from two of these headings it slid 46 cm into the corner.
+    let base = Scene::preset("lau-irregular-corner").unwrap();
+    let m = base.objects[0].marker.as_ref().unwrap();
+    let (mx, my) = (m.x, m.y);
+    let mut inside = 0;
+    for k in 0..8 {
+        let th = k as f64 * std::f64::consts::FRAC_PI_4;
+        let mut scene = base.clone();
+        // The marker 1.3 cm outside the left boundary (x = 0.2), half-way up the table.
+        let (s, c) = th.sin_cos();
+        scene.objects[0].pose = Pose::new(0.187 - (c * mx - s * my), 0.6 - (s * mx + c * my), th);
+        scene.robot.start = Pose::new(0.45, 0.6, std::f64::consts::PI);
+        let mut io = live_like(scene, 20 + k);
+        let before = io.object_pose().position();
+        let back = reset_robot_obj_boundary(&mut io, 0.02, 0.004).unwrap();
+        let after = io.object_pose().position();
+        eprintln!("heading {k}×45°: back {back}, marker {before:?} → {after:?}");
+        inside += usize::from(back);
+        assert!(
+            (after.y - before.y).abs() < 0.15,
+            "heading {k}×45°: the marker slid from {before:?} to {after:?}"
+        );
+    }
+    assert_eq!(inside, 8, "back inside from {inside} of 8 headings");
 }

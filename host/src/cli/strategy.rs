@@ -137,6 +137,11 @@ pub enum MethodArg {
 /// `pushbot eval delivery`.
 #[derive(Args, Debug)]
 pub struct DeliveryArgs {
+    /// Learned delivery's boundary guard: the band inside the boundary where the wanted object
+    /// motion is pulled inward and pushes are shortened, m; 0 is the paper's delivery, which
+    /// only fails once the object crosses the boundary [default: 0.06]
+    #[arg(long)]
+    pub boundary_guard: Option<f64>,
     /// Scene preset or file (e.g. lau-irregular), several separated by commas, or `lau-all`
     /// for the six objects of Lau et al.; scenes with obstacles are delivered along a global
     /// path (learned method).
@@ -458,10 +463,7 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
             scene: scene.clone(),
             object: a.object.clone(),
             sim: a.sim.options(global.seed)?,
-            delivery: DeliveryParams {
-                time_limit: a.time_limit,
-                ..DeliveryParams::default()
-            },
+            delivery: a.delivery_params()?,
             kernel: a.sim.kernel()?,
         };
         setup.goal().map_err(CliError::BadInput)?;
@@ -583,6 +585,24 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     })
 }
 
+impl DeliveryArgs {
+    /// The delivery parameters these arguments set (time limit, boundary guard).
+    fn delivery_params(&self) -> Result<DeliveryParams, CliError> {
+        let d = DeliveryParams::default();
+        let boundary_guard = self.boundary_guard.unwrap_or(d.boundary_guard);
+        if !(boundary_guard.is_finite() && boundary_guard >= 0.0) {
+            return Err(CliError::bad_input(
+                "--boundary-guard must be finite and not negative",
+            ));
+        }
+        Ok(DeliveryParams {
+            time_limit: self.time_limit,
+            boundary_guard,
+            ..d
+        })
+    }
+}
+
 /// `eval delivery --hil`: collect (or load) and deliver through the serial port and the camera.
 /// The live object cannot be put back at a start position, so each trial delivers it from
 /// wherever it is to the scene's goal, with one method.
@@ -617,10 +637,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
     let mut io = LiveRobot::connect(port, camera, scene, opts).map_err(CliError::Failed)?;
     let goal = obstacles::scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
     let kernel = a.sim.kernel()?;
-    let delivery = DeliveryParams {
-        time_limit: a.time_limit,
-        ..DeliveryParams::default()
-    };
+    let delivery = a.delivery_params()?;
     let mut collection = None;
     let samples: Vec<Sample> = match (method, &a.strategy) {
         (Method::Dipole, _) => Vec::new(),

@@ -121,6 +121,10 @@ pub fn reset_robot(io: &mut dyn RobotIo, epsilon: f64) -> Result<bool> {
     Ok(false)
 }
 
+/// How far a boundary reset may slide the object along the boundary (across the inward normal)
+/// in one round before it stops pushing, m.
+pub const SLIDE_LIMIT: f64 = 0.05;
+
 /// `reset_robot_obj_boundary()` (Fig. 3): the object's marker is outside the boundary; move the
 /// robot around the bound-all circle to the push-point (where the vector to the object's centre
 /// is perpendicular to the boundary, pointing inside) and push the object back in. Returns
@@ -163,10 +167,12 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             base.to_degrees()
         );
         circle_walk(io, o.position(), radius, push_angle, 0.05, &[])?;
+        let o0 = io.object_pose().position();
         // (d) Push towards the object until it is back inside; give up this round when six
         // pushes running did not bring it closer (it slides along the boundary, or is stuck).
         let mut still = 0;
         let start = distance_outside(&target, o.position());
+        let inward = -n;
         for _ in 0..30 {
             let o = io.object_pose();
             if target.contains(o.position()) {
@@ -179,9 +185,14 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             let d = aim - r.position();
             face(io, d.y.atan2(d.x), 0.05)?;
             io.forward(0.03)?;
-            let now = distance_outside(&target, io.object_pose().position());
-            if now > start + 0.02 {
-                // Pushed from the side, it slides along the edge and further out: stop.
+            let at = io.object_pose().position();
+            let now = distance_outside(&target, at);
+            let moved = at - o0;
+            let slid = (moved - moved.dot(&inward) * inward).norm();
+            if now > start + 0.02 || slid > SLIDE_LIMIT {
+                // Pushed from the side (an off-centre marker, a push-point pulled in from the
+                // table's edge), it slides along the edge rather than back in, and further out
+                // or into a corner: stop before it is out of the robot's reach.
                 break;
             }
             if now > away - epsilon {

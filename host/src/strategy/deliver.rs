@@ -18,7 +18,7 @@ use nalgebra::Vector2;
 use super::dipole::{self, DipoleCommand, DipoleParams};
 use super::obstacles::clearance;
 use super::regression::{PushStrategy, Reposition};
-use super::robot_io::{RobotIo, Workspace};
+use super::robot_io::{Rect, RobotIo, Workspace};
 use super::sample::{Pose2, Sample, wrap_angle};
 
 /// Parameters of delivery.
@@ -40,6 +40,11 @@ pub struct DeliveryParams {
     pub moved_epsilon: f64,
     /// Extra space of the bound-all circle beyond the robot's and the object's radii, m.
     pub bound_all_margin: f64,
+    /// Width of the band inside the boundary where the wanted object motion is pulled inward,
+    /// m (0: off, as in the paper).
+    pub boundary_guard: f64,
+    /// Strength of that pull at the boundary, relative to the unit goal direction.
+    pub boundary_pull: f64,
     /// Dipole baseline: length of one drive step, s.
     pub dipole_step: f64,
     /// Dipole baseline: controller parameters.
@@ -57,6 +62,8 @@ impl Default for DeliveryParams {
             heading_tolerance: 0.05,
             moved_epsilon: 0.003,
             bound_all_margin: 0.02,
+            boundary_guard: 0.06,
+            boundary_pull: 1.0,
             dipole_step: 0.25,
             dipole: DipoleParams::default(),
         }
@@ -209,6 +216,59 @@ fn path_len(traj: &[(Pose2, Pose2)], pick: fn(&(Pose2, Pose2)) -> Pose2) -> f64 
         .sum()
 }
 
+/// An inward pull on the wanted object motion near the boundary: for each edge of `boundary`
+/// closer to the object than `boundary_guard` (and closer to it than to the goal, so a goal by
+/// the edge is still reached), the edge's inward normal weighted by how far into the guard band
+/// the object is (0 at its inner side, `boundary_pull` at the edge). Not in Lau et al., whose
+/// delivery fails as soon as the object crosses the boundary: a strategy of a few hundred pushes
+/// drifts sideways by a centimetre or two per push, and an object started beside the boundary
+/// then leaves it while heading for the goal.
+fn boundary_bias(
+    boundary: &Rect,
+    o: Vector2<f64>,
+    goal: Vector2<f64>,
+    p: &DeliveryParams,
+) -> Vector2<f64> {
+    if p.boundary_guard <= 0.0 {
+        return Vector2::zeros();
+    }
+    let edges = [
+        (
+            o.x - boundary.min[0],
+            goal.x - boundary.min[0],
+            Vector2::x(),
+        ),
+        (
+            boundary.max[0] - o.x,
+            boundary.max[0] - goal.x,
+            -Vector2::x(),
+        ),
+        (
+            o.y - boundary.min[1],
+            goal.y - boundary.min[1],
+            Vector2::y(),
+        ),
+        (
+            boundary.max[1] - o.y,
+            boundary.max[1] - goal.y,
+            -Vector2::y(),
+        ),
+    ];
+    edges
+        .iter()
+        .filter(|(d, g, _)| *d < p.boundary_guard && *g > *d)
+        .map(|(d, _, n)| n * p.boundary_pull * (1.0 - d.max(0.0) / p.boundary_guard))
+        .sum()
+}
+
+/// Distance from `o` to the nearest edge of `boundary` (negative outside), m.
+fn edge_distance(boundary: &Rect, o: Vector2<f64>) -> f64 {
+    (o.x - boundary.min[0])
+        .min(boundary.max[0] - o.x)
+        .min(o.y - boundary.min[1])
+        .min(boundary.max[1] - o.y)
+}
+
 /// The checks every delivery loop makes each step: success or one of the failures.
 fn verdict(
     io: &mut dyn RobotIo,
@@ -345,7 +405,9 @@ pub fn deliver_learned_among(
         }
         let to_goal = goal - o.position();
         let dist = to_goal.norm();
-        let want = o.vector_to_local(to_goal / dist);
+        let bias = boundary_bias(&ws.boundary, o.position(), goal, p);
+        let want_world = to_goal / dist + bias;
+        let want = o.vector_to_local(want_world.normalize());
         let want = [want.x, want.y];
         tracing::debug!(
             "delivery step {steps}: object {:.3} m from the goal, {:.1} s, special {special}, \
@@ -363,6 +425,15 @@ pub fn deliver_learned_among(
             p.coarse_step
         } else {
             (0.8 * dist).clamp(0.006, p.fine_step)
+        };
+        // Within the guard band a push is no longer than 80 % of the way to the boundary: a
+        // quasi-static push moves the object no further than the pusher, so one push cannot
+        // carry it out before the next look.
+        let edge = edge_distance(&ws.boundary, o.position());
+        let step = if p.boundary_guard > 0.0 && edge < p.boundary_guard {
+            step.min((0.8 * edge).max(0.006))
+        } else {
+            step
         };
         let dir_world = if special {
             let Some(rep) = reachable_reposition(strategy, &ws, obstacles, &o, want, bound_all)
@@ -417,8 +488,10 @@ pub fn deliver_learned_among(
             sink(&sample)?;
         }
         // Special case next when the push moved the object away from the goal, or did not move
-        // it at all (the robot lost contact).
-        special = moved.norm() < p.moved_epsilon || moved.dot(&(goal - o0.position())) < 0.0;
+        // it at all (the robot lost contact), or — near the boundary — towards the boundary.
+        special = moved.norm() < p.moved_epsilon
+            || moved.dot(&(goal - o0.position())) < 0.0
+            || moved.dot(&bias) < 0.0;
     }
 }
 

@@ -11,7 +11,7 @@ use pushbot_sim::Scene;
 use super::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use super::obstacles::{ObstacleParams, deliver_among_obstacles, scene_obstacles};
 use super::regression::{KernelParams, PushStrategy};
-use super::robot_io::{SimRobot, SimRobotOptions};
+use super::robot_io::{RobotIo, SimRobot, SimRobotOptions};
 use super::sample::Sample;
 
 /// A delivery method.
@@ -114,6 +114,20 @@ pub fn run_start(
     let mut runs = Vec::with_capacity(trials);
     for t in 0..trials {
         let mut io = setup.robot(start, t)?;
+        let (ws, o) = (io.workspace(), io.true_object_pose());
+        if !ws.boundary.contains(o.position()) {
+            anyhow::bail!(
+                "start {start} puts the object's marker at ({:.3}, {:.3}), outside the boundary \
+                 x {:.3}..{:.3}, y {:.3}..{:.3} (a smaller --boundary-inset or a larger \
+                 --table-margin brings it inside)",
+                o.x,
+                o.y,
+                ws.boundary.min[0],
+                ws.boundary.max[0],
+                ws.boundary.min[1],
+                ws.boundary.max[1]
+            );
+        }
         let d = match method {
             Method::Learned if !setup.scene.obstacles.is_empty() => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
