@@ -97,7 +97,11 @@ fn learned_delivery_succeeds_from_two_starts_and_dipole_runs_beside_it() {
         let (res, runs) = run_start(&setup, Method::Learned, &samples, start, 1).unwrap();
         assert_eq!(res.successes, 1, "{start}: {res:?} {:?}", runs[0]);
         // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees within 3σ.
-        assert!(runs[0].final_distance < 0.025, "{:?}", runs[0].final_distance);
+        assert!(
+            runs[0].final_distance < 0.025,
+            "{:?}",
+            runs[0].final_distance
+        );
         // The object really travelled from its start to the goal.
         let p = setup.scene.position(start).unwrap();
         let straight = (goal - Vector2::new(p.x, p.y)).norm();
