@@ -241,12 +241,13 @@ impl Heuristic {
 /// A cell key: `(x, y, θ, contact)` indices, `x` tagged for refined cells.
 type Key = (i64, i64, i64, u32);
 
-/// One dense block of the pruning grid: the least cost each cell was expanded with.
+/// One dense block of the pruning grid: the least cost each cell was expanded with, as `u16`
+/// (`u16::MAX`: never) to halve its cache footprint; only built when MAXCOST fits below that.
 struct Block {
     lo: [i64; 3],
     dim: [i64; 3],
     contacts: i64,
-    cost: Vec<u32>,
+    cost: Vec<u16>,
 }
 
 impl Block {
@@ -260,7 +261,7 @@ impl Block {
             lo,
             dim,
             contacts: contacts as i64,
-            cost: vec![u32::MAX; n as usize],
+            cost: vec![u16::MAX; n as usize],
         })
     }
 
@@ -288,6 +289,13 @@ impl Grid {
         let contacts = p.contacts.len();
         let nt = (2.0 * std::f64::consts::PI / pa.grid_theta).ceil() as i64;
         let mut blocks = Vec::new();
+        if pa.max_cost >= u32::from(u16::MAX) {
+            // Costs would not fit the dense blocks: everything goes to the hash map.
+            return Grid {
+                blocks,
+                rest: GridMap::default(),
+            };
+        }
         let (w, h) = p.world.table;
         let coarse = Block::new(
             [0, 0, 0],
@@ -328,7 +336,12 @@ impl Grid {
     fn get(&self, k: Key) -> u32 {
         for b in &self.blocks {
             if let Some(i) = b.index(&k) {
-                return b.cost[i];
+                let c = b.cost[i];
+                return if c == u16::MAX {
+                    u32::MAX
+                } else {
+                    u32::from(c)
+                };
             }
         }
         self.rest.get(&k).copied().unwrap_or(u32::MAX)
@@ -337,7 +350,8 @@ impl Grid {
     fn set(&mut self, k: Key, g: u32) {
         for b in &mut self.blocks {
             if let Some(i) = b.index(&k) {
-                b.cost[i] = g;
+                // Blocks exist only when MAXCOST < u16::MAX, and expanded costs are ≤ MAXCOST.
+                b.cost[i] = u16::try_from(g).unwrap_or(u16::MAX - 1);
                 return;
             }
         }
@@ -437,29 +451,22 @@ impl Open {
 /// Whether the step of contact `ci`, control `k` from `from` (with `sc` = `(sin, cos)` of its
 /// angle) to `to` (`sc2` likewise) is free along its whole length.
 fn step_ok(p: &Problem, from: &Pose, sc: (f64, f64), ci: usize, k: usize, to: &Pose) -> bool {
-    let (steps, swept, _) = p.steps_swept_at(ci, from);
+    let cm = &p.contacts[ci];
+    let (xi, swept, (sd, cd)) = if p.near_goal(from) {
+        (&cm.fine_steps[k], &cm.fine_swept[k], cm.fine_delta_sc[k])
+    } else {
+        (&cm.steps[k], &cm.swept[k], cm.delta_sc[k])
+    };
     let frame = Frame {
         x: from.x,
         y: from.y,
         s: sc.0,
         c: sc.1,
     };
-    let sc2 = end_sc(p, from, sc, ci, k);
-    p.contacts[ci]
-        .body
-        .step_free_swept_in(&p.world, from, &frame, &steps[k], &swept[k], to, sc2)
-}
-
-/// `(sin, cos)` of the angle at the end of step `k` of contact `ci` from `from`, composed from
-/// `sc` (the start's) and the step's precomputed rotation.
-fn end_sc(p: &Problem, from: &Pose, sc: (f64, f64), ci: usize, k: usize) -> (f64, f64) {
-    let cm = &p.contacts[ci];
-    let (sd, cd) = if p.near_goal(from) {
-        cm.fine_delta_sc[k]
-    } else {
-        cm.delta_sc[k]
-    };
-    (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd)
+    // `(sin, cos)` at the step's end, composed from the start's and the step's rotation.
+    let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
+    cm.body
+        .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
 }
 
 /// Plan with the given OPEN list.
@@ -570,10 +577,12 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
         ));
         let sc = n.q.theta.sin_cos();
         nodes[id as usize].sc = sc;
+        let fine = p.near_goal(&n.q);
         let lazy = checks == Checks::Lazy;
         for ci in 0..p.contacts.len() {
-            let (steps, _, deltas) = p.steps_swept_at(ci, &n.q);
-            for k in 0..steps.len() {
+            let cm = &p.contacts[ci];
+            let deltas = if fine { &cm.fine_deltas } else { &cm.deltas };
+            for k in 0..deltas.len() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
                 };
