@@ -33,7 +33,7 @@ fn lazy_collision_checks_give_the_eager_plan() {
             };
             if trial > 0 {
                 // A random free start and goal.
-                let mut pick = |rng: &mut rand::rngs::StdRng| loop {
+                let pick = |rng: &mut rand::rngs::StdRng| loop {
                     let q = Pose::new(
                         rng.random_range(0.0..w),
                         rng.random_range(0.0..h),
@@ -63,5 +63,8 @@ fn lazy_collision_checks_give_the_eager_plan() {
         }
     }
     // Both outcomes must occur for the comparison to mean something.
-    assert!(runs >= 40 && found >= 5 && found < runs, "{found} of {runs}");
+    assert!(
+        runs >= 40 && found >= 5 && found < runs,
+        "{found} of {runs}"
+    );
 }
