@@ -23,7 +23,7 @@ use crate::mechanics::{MechanicsError, Slider, V2, V3};
 use collision::{Body, World};
 use pusher::{Placement, Pusher, Usable};
 
-pub use search::{Plan, Queue, plan, plan_with};
+pub use search::{Checks, Plan, Queue, plan, plan_checked, plan_with};
 
 /// A slider configuration `(x, y, θ)` in the world frame.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -107,8 +107,23 @@ pub fn cor_of(xi: &V3) -> Option<V2> {
 
 /// `a − b` wrapped into `(−π, π]`.
 pub fn angle_diff(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(2.0 * PI);
+    let d = wrap_2pi(a - b);
     if d > PI { d - 2.0 * PI } else { d }
+}
+
+/// `θ mod 2π` in `[0, 2π)`, bit for bit as `θ.rem_euclid(2π)`, which it calls only for angles
+/// outside `(−2π, 2π)` (the planner's hot loop otherwise pays for `fmod`): `fmod` is exact, so
+/// for `θ ∈ [0, 2π)` it returns `θ`, and for `θ ∈ (−2π, 0)` it returns `θ` and `rem_euclid`
+/// adds `2π` (at `−2π` it returns `−0`, kept as is).
+pub fn wrap_2pi(theta: f64) -> f64 {
+    const TAU: f64 = 2.0 * PI;
+    if (0.0..TAU).contains(&theta) {
+        theta
+    } else if theta > -TAU && theta < 0.0 {
+        theta + TAU
+    } else {
+        theta.rem_euclid(TAU)
+    }
 }
 
 /// Planner parameters (§4.2.2–4.2.4).
@@ -342,5 +357,27 @@ mod tests {
         // Rotation about the centre of friction by π/2 keeps the position.
         let r = q.integrate(&V3::new(0.0, 0.0, PI / 2.0));
         assert!((r.x - 1.0).abs() < 1e-12 && (r.y - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn wrap_2pi_is_rem_euclid_bit_for_bit() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let edges = [0.0, -0.0, 2.0 * PI, -2.0 * PI, PI, -PI, 1e-300, -1e-300];
+        let mut samples: Vec<f64> = edges.to_vec();
+        samples.extend(edges.iter().map(|e| f64::from_bits(e.to_bits() + 1)));
+        samples.extend((0..100_000).map(|_| (next() - 0.5) * 40.0));
+        for t in samples {
+            assert_eq!(
+                wrap_2pi(t).to_bits(),
+                t.rem_euclid(2.0 * PI).to_bits(),
+                "{t:e}"
+            );
+        }
     }
 }

@@ -101,6 +101,18 @@ pub enum Queue {
     Heap,
 }
 
+/// When a generated step's collision is checked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Checks {
+    /// When the step is generated, before it enters OPEN (the paper's order, §4.2.1).
+    Eager,
+    /// When its node is taken from OPEN, before the goal test and the grid is marked: a node
+    /// whose cell is already occupied at that time, or that is never taken before the search
+    /// ends, is never checked. The search expands the same nodes in the same order and
+    /// returns the same plan as [`Checks::Eager`] (a colliding node in OPEN is only skipped).
+    Lazy,
+}
+
 #[derive(Clone)]
 struct Node {
     q: Pose,
@@ -110,6 +122,10 @@ struct Node {
     cost: u32,
     needs_transit: bool,
     transit: u32,
+    /// The step into this node still awaits its collision check ([`Checks::Lazy`]).
+    unchecked: bool,
+    /// `(sin θ, cos θ)` of `q`, set when the node is expanded (its children's checks use it).
+    sc: (f64, f64),
 }
 
 /// An admissible lower bound on the cost still to pay from a configuration to the goal
@@ -225,12 +241,13 @@ impl Heuristic {
 /// A cell key: `(x, y, θ, contact)` indices, `x` tagged for refined cells.
 type Key = (i64, i64, i64, u32);
 
-/// One dense block of the pruning grid: the least cost each cell was expanded with.
+/// One dense block of the pruning grid: the least cost each cell was expanded with, as `u16`
+/// (`u16::MAX`: never) to halve its cache footprint; only built when MAXCOST fits below that.
 struct Block {
     lo: [i64; 3],
     dim: [i64; 3],
     contacts: i64,
-    cost: Vec<u32>,
+    cost: Vec<u16>,
 }
 
 impl Block {
@@ -244,7 +261,7 @@ impl Block {
             lo,
             dim,
             contacts: contacts as i64,
-            cost: vec![u32::MAX; n as usize],
+            cost: vec![u16::MAX; n as usize],
         })
     }
 
@@ -272,6 +289,13 @@ impl Grid {
         let contacts = p.contacts.len();
         let nt = (2.0 * std::f64::consts::PI / pa.grid_theta).ceil() as i64;
         let mut blocks = Vec::new();
+        if pa.max_cost >= u32::from(u16::MAX) {
+            // Costs would not fit the dense blocks: everything goes to the hash map.
+            return Grid {
+                blocks,
+                rest: GridMap::default(),
+            };
+        }
         let (w, h) = p.world.table;
         let coarse = Block::new(
             [0, 0, 0],
@@ -312,7 +336,12 @@ impl Grid {
     fn get(&self, k: Key) -> u32 {
         for b in &self.blocks {
             if let Some(i) = b.index(&k) {
-                return b.cost[i];
+                let c = b.cost[i];
+                return if c == u16::MAX {
+                    u32::MAX
+                } else {
+                    u32::from(c)
+                };
             }
         }
         self.rest.get(&k).copied().unwrap_or(u32::MAX)
@@ -321,7 +350,8 @@ impl Grid {
     fn set(&mut self, k: Key, g: u32) {
         for b in &mut self.blocks {
             if let Some(i) = b.index(&k) {
-                b.cost[i] = g;
+                // Blocks exist only when MAXCOST < u16::MAX, and expanded costs are ≤ MAXCOST.
+                b.cost[i] = u16::try_from(g).unwrap_or(u16::MAX - 1);
                 return;
             }
         }
@@ -336,7 +366,7 @@ pub fn plan(p: &Problem) -> Plan {
 
 /// The grid cell of a configuration.
 fn cell(p: &Problem, q: &Pose, contact: u32) -> Key {
-    let th = q.theta.rem_euclid(2.0 * std::f64::consts::PI);
+    let th = super::wrap_2pi(q.theta);
     // Refined cells near the goal carry a tag so they never share a key with coarse cells.
     let (f, tag) = if p.near_goal(q) {
         (p.params.fine_factor, 1i64 << 40)
@@ -418,6 +448,27 @@ impl Open {
     }
 }
 
+/// Whether the step of contact `ci`, control `k` from `from` (with `sc` = `(sin, cos)` of its
+/// angle) to `to` (`sc2` likewise) is free along its whole length.
+fn step_ok(p: &Problem, from: &Pose, sc: (f64, f64), ci: usize, k: usize, to: &Pose) -> bool {
+    let cm = &p.contacts[ci];
+    let (xi, swept, (sd, cd)) = if p.near_goal(from) {
+        (&cm.fine_steps[k], &cm.fine_swept[k], cm.fine_delta_sc[k])
+    } else {
+        (&cm.steps[k], &cm.swept[k], cm.delta_sc[k])
+    };
+    let frame = Frame {
+        x: from.x,
+        y: from.y,
+        s: sc.0,
+        c: sc.1,
+    };
+    // `(sin, cos)` at the step's end, composed from the start's and the step's rotation.
+    let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
+    cm.body
+        .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
+}
+
 /// Plan with the given OPEN list.
 ///
 /// A* on `f = g + h` ([`Heuristic`]). The paper prunes a configuration whose grid cell was
@@ -425,6 +476,11 @@ impl Open {
 /// remembers the least cost `g` each cell was expanded with, so a cell reached again more
 /// cheaply (possible once the order is by `f`, not `g`) is expanded again.
 pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
+    plan_checked(p, queue, Checks::Lazy)
+}
+
+/// Plan with the given OPEN list and collision-check timing ([`Checks`]).
+pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();
     let heur = Heuristic::new(p);
     let mut nodes: Vec<Node> = vec![Node {
@@ -435,6 +491,8 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
         cost: 0,
         needs_transit: false,
         transit: NONE,
+        unchecked: false,
+        sc: (0.0, 1.0),
     }];
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
@@ -448,11 +506,32 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
         Queue::Heap => Open::Heap(BinaryHeap::new()),
     };
     open.push(heur.cost(heur.steps(&p.start)), 0);
+    let heur_zero = heur.cost(u32::MAX) == 0;
     let mut expanded = 0usize;
     let mut goal_node = None;
     // The start must be free for some contact's body; each step checks its own body.
     while let Some(id) = open.pop() {
         let n = nodes[id as usize].clone();
+        // The node's grid cell (the start, with no contact yet, has none).
+        let key = (n.contact != NONE).then(|| cell(p, &n.q, n.contact));
+        let in_goal = p.in_goal(&n.q);
+        if n.unchecked {
+            // Pruned at the grid test below anyway (unless it is a goal): skip the check.
+            if !in_goal && key.is_some_and(|k| occupied.get(k) <= n.cost) {
+                continue;
+            }
+            let par = &nodes[n.parent as usize];
+            if !step_ok(
+                p,
+                &par.q,
+                par.sc,
+                n.contact as usize,
+                n.control as usize,
+                &n.q,
+            ) {
+                continue;
+            }
+        }
         if n.needs_transit {
             let key = (n.parent, n.contact);
             let t = *transit_cache.entry(key).or_insert_with(|| {
@@ -474,12 +553,11 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                 None => continue,
             }
         }
-        if p.in_goal(&n.q) {
+        if in_goal {
             goal_node = Some(id);
             break;
         }
-        if n.contact != NONE {
-            let key = cell(p, &n.q, n.contact);
+        if let Some(key) = key {
             if occupied.get(key) <= n.cost {
                 continue;
             }
@@ -498,20 +576,13 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
             },
         ));
         let sc = n.q.theta.sin_cos();
-        let frame = Frame {
-            x: n.q.x,
-            y: n.q.y,
-            s: sc.0,
-            c: sc.1,
-        };
-        for (ci, cm) in p.contacts.iter().enumerate() {
-            let (steps, swept, deltas) = p.steps_swept_at(ci, &n.q);
-            let dsc = if p.near_goal(&n.q) {
-                &cm.fine_delta_sc
-            } else {
-                &cm.delta_sc
-            };
-            for (k, xi) in steps.iter().enumerate() {
+        nodes[id as usize].sc = sc;
+        let fine = p.near_goal(&n.q);
+        let lazy = checks == Checks::Lazy;
+        for ci in 0..p.contacts.len() {
+            let cm = &p.contacts[ci];
+            let deltas = if fine { &cm.fine_deltas } else { &cm.deltas };
+            for k in 0..deltas.len() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
                 };
@@ -520,20 +591,20 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     continue;
                 }
                 let q2 = n.q.compose(&deltas[k], sc);
-                let (sd, cd) = dsc[k];
-                let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
-                let hs = heur.steps(&q2);
-                let f = cost.saturating_add(heur.cost(hs));
-                if f > max_cost {
-                    continue;
-                }
+                // Both tests only filter; the grid's, more selective, goes first. With `a = 0`
+                // the bound is 0 and is not computed.
                 if occupied.get(cell(p, &q2, ci as u32)) <= cost {
                     continue;
                 }
-                if !cm
-                    .body
-                    .step_free_swept_in(&p.world, &n.q, &frame, xi, &swept[k], &q2, sc2)
-                {
+                let f = if heur_zero {
+                    cost
+                } else {
+                    cost.saturating_add(heur.cost(heur.steps(&q2)))
+                };
+                if f > max_cost {
+                    continue;
+                }
+                if !lazy && !step_ok(p, &n.q, sc, ci, k, &q2) {
                     continue;
                 }
                 let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
@@ -545,6 +616,8 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
                     cost,
                     needs_transit,
                     transit: NONE,
+                    unchecked: lazy,
+                    sc: (0.0, 1.0),
                 });
                 open.push(f, (nodes.len() - 1) as u32);
             }
