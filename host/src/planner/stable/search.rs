@@ -582,7 +582,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
         for ci in 0..p.contacts.len() {
             let cm = &p.contacts[ci];
             let deltas = if fine { &cm.fine_deltas } else { &cm.deltas };
-            for k in 0..deltas.len() {
+            for (k, delta) in deltas.iter().enumerate() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
                     continue;
                 };
@@ -590,7 +590,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 if cost > max_cost {
                     continue;
                 }
-                let q2 = n.q.compose(&deltas[k], sc);
+                let q2 = n.q.compose(delta, sc);
                 // Both tests only filter; the grid's, more selective, goes first. With `a = 0`
                 // the bound is 0 and is not computed.
                 if occupied.get(cell(p, &q2, ci as u32)) <= cost {
