@@ -226,3 +226,31 @@ fn exit_codes_are_in_the_top_level_help() {
         assert!(r.stdout.contains(needle), "{needle}: {}", r.stdout);
     }
 }
+
+#[test]
+fn exact_goal_finishes_a_car_plan_and_says_clearly_when_nothing_finishes() {
+    let run = |scene: &str| {
+        std::process::Command::new(pushbot_tests::bin("pushbot"))
+            .args(["--json", "plan", "stable", "--scene", scene, "--exact-goal"])
+            .output()
+            .expect("run pushbot")
+    };
+    // Fig. 15's car-like pusher has no single exact push (its pushes turn about its rear
+    // axle only); the Dubins finish of its tightest stable turns ends on the goal.
+    let out = run("fig15");
+    assert!(out.status.success(), "{out:?}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(v["found"], true, "{v}");
+    assert_eq!(v["exact_goal"], true, "{v}");
+    // Fig. 16's arm plan has no configuration from which one stable push ends on the goal:
+    // a failure (exit 1) with the reason, as JSON on stdout.
+    let out = run("fig16");
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert!(
+        v["error"]["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("no exact finish")),
+        "{v}"
+    );
+}

@@ -157,7 +157,7 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ),
     (
         "plan stable",
-        "pushbot plan stable --scene fig16 --exact-goal --svg fig16.svg",
+        "pushbot plan stable --scene fig15 --exact-goal --svg fig15.svg",
     ),
     (
         "collect",

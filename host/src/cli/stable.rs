@@ -10,8 +10,8 @@ use super::{CliError, CliResult, Global, Status};
 use crate::mechanics::controllability::{self, PushBoundary};
 use crate::mechanics::stable::stable_all_edges;
 use crate::mechanics::{LineContact, cor};
+use crate::planner::stable::exact::finish_exactly;
 use crate::planner::stable::presets::{CostOverride, PAPER_SECONDS, PRESETS, load_scene};
-use crate::planner::stable::search::exact_goal;
 use crate::planner::stable::{plan, svg};
 
 /// `pushbot mechanics`: STABLE per edge and the controllability verdicts.
@@ -40,7 +40,8 @@ pub struct PlanStableArgs {
     /// Cost per contact change, or "inf".
     #[arg(long)]
     pub c: Option<String>,
-    /// Back up and finish with one stable push exactly onto the goal (§4.5).
+    /// Back up and finish exactly on the goal (§4.5): with one stable push, or, for a car or a
+    /// differential drive, with the Dubins path of its tightest stable turns.
     #[arg(long)]
     pub exact_goal: bool,
     /// Draw the plan as SVG into this file.
@@ -165,14 +166,14 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
     let mut p = plan(&problem);
     if a.exact_goal && p.found {
         let t = p.plan_time_ms;
-        match exact_goal(&problem, &p) {
+        match finish_exactly(&problem, &p) {
             Some(mut e) => {
                 e.plan_time_ms = t;
                 p = e;
             }
             None => {
                 return Err(CliError::Failed(anyhow::anyhow!(
-                    "no single stable push reaches the goal exactly"
+                    "no exact finish reaches the goal: neither one stable push nor a Dubins path of stable pushes (wheeled pushers) is free of collision from any configuration of the plan"
                 )));
             }
         }

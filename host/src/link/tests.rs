@@ -53,7 +53,7 @@ impl Fake {
                 if let Ok(n) = master.read(&mut buf) {
                     for &b in &buf[..n] {
                         if let Some(Ok(f)) = dec.push::<HostFrame>(b) {
-                            let mut s = st.lock().unwrap();
+                            let mut s = st.lock().unwrap_or_else(|e| e.into_inner());
                             s.received.push(f);
                             if f.cmd == Command::Heartbeat {
                                 let t = s.time_us;
@@ -64,7 +64,7 @@ impl Fake {
                         }
                     }
                 }
-                let mut s = st.lock().unwrap();
+                let mut s = st.lock().unwrap_or_else(|e| e.into_inner());
                 if s.quit {
                     return; // drops the master: the host's port vanishes
                 }
@@ -101,10 +101,13 @@ impl Fake {
         }
     }
 
+    /// Stop the fake robot. A lock poisoned by a failed assertion is still taken, and a
+    /// panicked thread is not re-raised, so a failing test reports its own message instead of
+    /// aborting on a panic during unwinding.
     fn quit(&mut self) {
-        self.state.lock().unwrap().quit = true;
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).quit = true;
         if let Some(t) = self.thread.take() {
-            t.join().unwrap();
+            let _ = t.join();
         }
     }
 }
@@ -361,9 +364,18 @@ fn heartbeats_follow_robot_time() {
         "{} heartbeats in 3 s of robot time",
         hb.len()
     );
-    let worst = hb.windows(2).map(|w| w[1] - w[0]).max().unwrap();
-    // Quarter watchdog (50 ms) plus telemetry and pipe latency; the watchdog is 200 ms.
-    assert!(worst <= 150_000, "largest gap {worst} us of robot time");
+    // Quarter watchdog (50 ms of robot time) plus telemetry and pipe latency. Judged on the
+    // 90th percentile of the gaps: a loaded test machine can stall a thread for tens of ms of
+    // wall time, hundreds of ms of robot time at 10x, once in a while; heartbeats paced by the
+    // wall clock instead would leave 500 ms gaps here, and about 6 heartbeats, not 30.
+    let mut gaps: Vec<u64> = hb.windows(2).map(|w| w[1] - w[0]).collect();
+    gaps.sort_unstable();
+    let p90 = gaps[gaps.len() * 9 / 10];
+    assert!(
+        p90 <= 100_000,
+        "90th percentile heartbeat gap {p90} us of robot time (largest {} us)",
+        gaps.last().unwrap()
+    );
 }
 
 #[test]

@@ -6,9 +6,11 @@
 //! kept in a bucketed OPEN list, pruning on a configuration grid per contact (§4.2.3), a goal
 //! neighbourhood, MAXCOST and a node limit (§4.2.4). Beyond the paper: exact collision of
 //! pusher + slider along every step ([`collision`]), transit paths for a mobile pusher between
-//! contacts (§4.6's open problem, [`transit`]), and the exact-goal variant of §4.5.
+//! contacts (§4.6's open problem, [`transit`]), and the exact-goal variant of §4.5, for wheeled
+//! pushers too ([`exact`]).
 
 pub mod collision;
+pub mod exact;
 pub mod execute;
 pub mod presets;
 pub mod pusher;
