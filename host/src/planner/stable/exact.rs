@@ -18,6 +18,7 @@
 use dubins_paths::SegmentType;
 use dubins_paths::f64::{DubinsPath, PosRot};
 
+use super::pusher::PusherKind;
 use super::search::{self, Plan, Step, summarise};
 use super::{Pose, Problem};
 use crate::mechanics::{V2, V3};
@@ -36,32 +37,63 @@ struct Push {
     control: usize,
 }
 
+/// A wheeled pusher on one contact, in the slider frame: its axle centre `a`, forward `n`,
+/// left `l`, and the tightest turning radius its stable set allows on either side.
+#[derive(Debug, Clone, Copy)]
+struct Axle {
+    a: V2,
+    n: V2,
+    l: V2,
+    rho: f64,
+}
+
+impl Axle {
+    /// The axle of contact `ci`; `None` for a pusher without one (arm, omnidirectional).
+    fn of(p: &Problem, ci: usize) -> Option<Axle> {
+        let cm = &p.contacts[ci];
+        if !matches!(
+            p.pusher.kind,
+            PusherKind::Car { .. } | PusherKind::DiffDrive
+        ) {
+            return None;
+        }
+        let pl = &cm.placement;
+        let a = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
+        let n = pl.normal;
+        // The extremal rotation centres are the tightest stable turns.
+        let rho = cm
+            .usable
+            .controls
+            .iter()
+            .filter_map(super::cor_of)
+            .map(|c| (c - a).norm())
+            .fold(0.0, f64::max)
+            * (1.0 + 1e-6);
+        (rho > 0.0).then_some(Axle {
+            a,
+            n,
+            l: V2::new(-n.y, n.x),
+            rho,
+        })
+    }
+
+    /// The twist of a turn of the axle centre through `phi` (left if positive) at radius `rho`.
+    fn turn(&self, phi: f64) -> V3 {
+        let c = self.a + self.l * (self.rho * phi.signum());
+        V3::new(phi * c.y, -phi * c.x, phi)
+    }
+}
+
 /// The exact finishes with contact `ci` from `q` onto `goal`: the Dubins words of the robot's
 /// axle centre at the largest extremal turning radius of the contact, each turned into pushes
 /// (slider-frame twists), shortest first. Only those whose every push is usable and
 /// collision-free. Empty for a pusher without an axle (arm, omnidirectional).
 fn dubins_finishes(p: &Problem, ci: usize, q: &Pose, goal: &Pose) -> Vec<Vec<Push>> {
     let cm = &p.contacts[ci];
-    if !p.pusher.is_mobile() || cm.footprint.is_empty() {
+    let Some(axle) = Axle::of(p, ci) else {
         return Vec::new();
-    }
-    let pl = &cm.placement;
-    // Slider frame: the axle centre `a`, forward `n`, left `l`.
-    let a = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
-    let n = pl.normal;
-    let l = V2::new(-n.y, n.x);
-    // The tightest turn the stable set allows on either side: the extremal rotation centres.
-    let rho = cm
-        .usable
-        .controls
-        .iter()
-        .filter_map(super::cor_of)
-        .map(|c| (c - a).norm())
-        .fold(0.0, f64::max)
-        * (1.0 + 1e-6);
-    if rho <= 0.0 {
-        return Vec::new();
-    }
+    };
+    let Axle { a, n, rho, .. } = axle;
     let robot = |q: &Pose| {
         let at = q.apply(a);
         let h = q.rotate(n);
@@ -93,18 +125,14 @@ fn dubins_finishes(p: &Problem, ci: usize, q: &Pose, goal: &Pose) -> Vec<Vec<Pus
                         xi: V3::new(n.x, n.y, 0.0) * len,
                         control: straight_control,
                     },
-                    SegmentType::L | SegmentType::R => {
-                        let (side, phi, control) = if kind == SegmentType::L {
-                            (1.0, len / rho, EXACT_LEFT)
-                        } else {
-                            (-1.0, -len / rho, EXACT_RIGHT)
-                        };
-                        let c = a + l * (side * rho);
-                        Push {
-                            xi: V3::new(phi * c.y, -phi * c.x, phi),
-                            control,
-                        }
-                    }
+                    SegmentType::L => Push {
+                        xi: axle.turn(len / rho),
+                        control: EXACT_LEFT,
+                    },
+                    SegmentType::R => Push {
+                        xi: axle.turn(-len / rho),
+                        control: EXACT_RIGHT,
+                    },
                 };
                 pushes.push(push);
             }
