@@ -12,7 +12,7 @@
 //! goal exactly.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap, VecDeque};
+use std::collections::{BinaryHeap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
@@ -113,19 +113,31 @@ pub enum Checks {
     Lazy,
 }
 
-#[derive(Clone)]
-struct Node {
+/// A configuration taken from OPEN and expanded, or the goal: the search tree's inner nodes.
+#[derive(Clone, Copy)]
+struct Expanded {
     q: Pose,
+    /// `(sin θ, cos θ)` of `q` (its children's steps and checks use it).
+    sc: (f64, f64),
+    /// Whether `q` is in the refined region (§4.5): its children take the fine steps.
+    fine: bool,
     contact: u32,
     control: u32,
     parent: u32,
     cost: u32,
-    needs_transit: bool,
     transit: u32,
-    /// The step into this node still awaits its collision check ([`Checks::Lazy`]).
-    unchecked: bool,
-    /// `(sin θ, cos θ)` of `q`, set when the node is expanded (its children's checks use it).
-    sc: (f64, f64),
+}
+
+/// A generated step waiting in OPEN: control `control` of contact `contact` from the expanded
+/// node `parent` (`NONE`: the start itself), reaching cost `cost`. Its end configuration is
+/// recomputed from the parent when it is taken, with the same arithmetic, so bit for bit the
+/// one tested when it was generated; OPEN holds 16 bytes per entry.
+#[derive(Clone, Copy)]
+struct Pending {
+    parent: u32,
+    contact: u32,
+    control: u32,
+    cost: u32,
 }
 
 /// An admissible lower bound on the cost still to pay from a configuration to the goal
@@ -409,41 +421,60 @@ pub fn step_cost(
     Some(c)
 }
 
-/// OPEN: the paper's cost-indexed FIFO lists, or one heap.
+/// One of the paper's FIFO lists: a vector read from `head` on.
+#[derive(Clone, Default)]
+struct Fifo {
+    items: Vec<Pending>,
+    head: usize,
+}
+
+/// OPEN: the paper's cost-indexed FIFO lists, or one heap (ordered by `(f, insertion order)`
+/// over a store of the entries).
 enum Open {
     Buckets {
-        lists: Vec<VecDeque<u32>>,
+        lists: Vec<Fifo>,
         cur: usize,
     },
-    Heap(BinaryHeap<Reverse<(u32, u32)>>),
+    Heap {
+        heap: BinaryHeap<Reverse<(u32, u32)>>,
+        store: Vec<Pending>,
+    },
 }
 
 impl Open {
-    fn push(&mut self, f: u32, id: u32) {
+    fn push(&mut self, f: u32, n: Pending) {
         match self {
             Open::Buckets { lists, cur } => {
                 let f = f as usize;
                 if f < lists.len() {
-                    lists[f].push_back(id);
+                    lists[f].items.push(n);
                     *cur = (*cur).min(f);
                 }
             }
-            Open::Heap(h) => h.push(Reverse((f, id))),
+            Open::Heap { heap, store } => {
+                heap.push(Reverse((f, store.len() as u32)));
+                store.push(n);
+            }
         }
     }
 
-    fn pop(&mut self) -> Option<u32> {
+    fn pop(&mut self) -> Option<Pending> {
         match self {
             Open::Buckets { lists, cur } => {
-                while *cur < lists.len() {
-                    if let Some(id) = lists[*cur].pop_front() {
-                        return Some(id);
+                while let Some(l) = lists.get_mut(*cur) {
+                    if let Some(&n) = l.items.get(l.head) {
+                        l.head += 1;
+                        if l.head == l.items.len() {
+                            // Drained: free it (a later push reallocates).
+                            *l = Fifo::default();
+                        }
+                        return Some(n);
                     }
                     *cur += 1;
                 }
                 None
             }
-            Open::Heap(h) => h.pop().map(|Reverse((_, id))| id),
+            Open::Heap { heap, store } => heap.pop().map(|Reverse((_, i))| store[i as usize]),
         }
     }
 }
@@ -483,78 +514,111 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
 pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();
     let heur = Heuristic::new(p);
-    let mut nodes: Vec<Node> = vec![Node {
-        q: p.start,
-        contact: p.start_contact.map_or(NONE, |c| c as u32),
-        control: NONE,
-        parent: NONE,
-        cost: 0,
-        needs_transit: false,
-        transit: NONE,
-        unchecked: false,
-        sc: (0.0, 1.0),
-    }];
+    // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
+    let mut closed: Vec<Expanded> = Vec::new();
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
     let mut occupied = Grid::new(p);
     let max_cost = p.params.max_cost;
     let mut open = match queue {
         Queue::Buckets => Open::Buckets {
-            lists: vec![VecDeque::new(); max_cost as usize + 1],
+            lists: vec![Fifo::default(); max_cost as usize + 1],
             cur: 0,
         },
-        Queue::Heap => Open::Heap(BinaryHeap::new()),
+        Queue::Heap => Open::Heap {
+            heap: BinaryHeap::new(),
+            store: Vec::new(),
+        },
     };
-    open.push(heur.cost(heur.steps(&p.start)), 0);
+    let start_contact = p.start_contact.map_or(NONE, |c| c as u32);
+    open.push(
+        heur.cost(heur.steps(&p.start)),
+        Pending {
+            parent: NONE,
+            contact: start_contact,
+            control: NONE,
+            cost: 0,
+        },
+    );
     let heur_zero = heur.cost(u32::MAX) == 0;
+    let lazy = checks == Checks::Lazy;
+    let mobile = p.pusher.is_mobile();
     let mut expanded = 0usize;
     let mut goal_node = None;
     // The start must be free for some contact's body; each step checks its own body.
-    while let Some(id) = open.pop() {
-        let n = nodes[id as usize].clone();
+    while let Some(n) = open.pop() {
+        // The configuration: the start, or the parent's step (as when it was generated).
+        let q = if n.parent == NONE {
+            p.start
+        } else {
+            let par = &closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let d = if par.fine {
+                &cm.fine_deltas[n.control as usize]
+            } else {
+                &cm.deltas[n.control as usize]
+            };
+            par.q.compose(d, par.sc)
+        };
         // The node's grid cell (the start, with no contact yet, has none).
-        let key = (n.contact != NONE).then(|| cell(p, &n.q, n.contact));
-        let in_goal = p.in_goal(&n.q);
-        if n.unchecked {
+        let key = (n.contact != NONE).then(|| cell(p, &q, n.contact));
+        let in_goal = p.in_goal(&q);
+        if lazy && n.parent != NONE {
             // Pruned at the grid test below anyway (unless it is a goal): skip the check.
             if !in_goal && key.is_some_and(|k| occupied.get(k) <= n.cost) {
                 continue;
             }
-            let par = &nodes[n.parent as usize];
+            let par = &closed[n.parent as usize];
             if !step_ok(
                 p,
                 &par.q,
                 par.sc,
                 n.contact as usize,
                 n.control as usize,
-                &n.q,
+                &q,
             ) {
                 continue;
             }
         }
-        if n.needs_transit {
-            let key = (n.parent, n.contact);
-            let t = *transit_cache.entry(key).or_insert_with(|| {
-                let par = &nodes[n.parent as usize];
-                transit(
-                    p,
-                    &par.q,
-                    par.contact as usize,
-                    n.contact as usize,
-                    nodes.len() as u32,
-                )
-                .map(|tp| {
-                    transits.push(tp);
-                    (transits.len() - 1) as u32
-                })
-            });
-            match t {
-                Some(ti) => nodes[id as usize].transit = ti,
-                None => continue,
+        let mut transit_id = NONE;
+        if mobile && n.parent != NONE && closed[n.parent as usize].contact != NONE {
+            let par_contact = closed[n.parent as usize].contact;
+            if par_contact != n.contact {
+                let t = *transit_cache
+                    .entry((n.parent, n.contact))
+                    .or_insert_with(|| {
+                        let par = &closed[n.parent as usize];
+                        transit(
+                            p,
+                            &par.q,
+                            par.contact as usize,
+                            n.contact as usize,
+                            closed.len() as u32,
+                        )
+                        .map(|tp| {
+                            transits.push(tp);
+                            (transits.len() - 1) as u32
+                        })
+                    });
+                match t {
+                    Some(ti) => transit_id = ti,
+                    None => continue,
+                }
             }
         }
+        let node = Expanded {
+            q,
+            sc: (0.0, 1.0),
+            fine: false,
+            contact: n.contact,
+            control: n.control,
+            parent: n.parent,
+            cost: n.cost,
+            transit: transit_id,
+        };
         if in_goal {
-            goal_node = Some(id);
+            closed.push(node);
+            goal_node = Some((closed.len() - 1) as u32);
             break;
         }
         if let Some(key) = key {
@@ -575,12 +639,11 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 n.control as usize
             },
         ));
-        let sc = n.q.theta.sin_cos();
-        nodes[id as usize].sc = sc;
-        let fine = p.near_goal(&n.q);
-        let lazy = checks == Checks::Lazy;
-        for ci in 0..p.contacts.len() {
-            let cm = &p.contacts[ci];
+        let sc = q.theta.sin_cos();
+        let fine = p.near_goal(&q);
+        let me = closed.len() as u32;
+        closed.push(Expanded { sc, fine, ..node });
+        for (ci, cm) in p.contacts.iter().enumerate() {
             let deltas = if fine { &cm.fine_deltas } else { &cm.deltas };
             for (k, delta) in deltas.iter().enumerate() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
@@ -590,7 +653,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 if cost > max_cost {
                     continue;
                 }
-                let q2 = n.q.compose(delta, sc);
+                let q2 = q.compose(delta, sc);
                 // Both tests only filter; the grid's, more selective, goes first. With `a = 0`
                 // the bound is 0 and is not computed.
                 if occupied.get(cell(p, &q2, ci as u32)) <= cost {
@@ -604,22 +667,18 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 if f > max_cost {
                     continue;
                 }
-                if !lazy && !step_ok(p, &n.q, sc, ci, k, &q2) {
+                if !lazy && !step_ok(p, &q, sc, ci, k, &q2) {
                     continue;
                 }
-                let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
-                nodes.push(Node {
-                    q: q2,
-                    contact: ci as u32,
-                    control: k as u32,
-                    parent: id,
-                    cost,
-                    needs_transit,
-                    transit: NONE,
-                    unchecked: lazy,
-                    sc: (0.0, 1.0),
-                });
-                open.push(f, (nodes.len() - 1) as u32);
+                open.push(
+                    f,
+                    Pending {
+                        parent: me,
+                        contact: ci as u32,
+                        control: k as u32,
+                        cost,
+                    },
+                );
             }
         }
     }
@@ -638,14 +697,14 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     if let Some(g) = goal_node {
         let mut chain = Vec::new();
         let mut i = g;
-        while nodes[i as usize].parent != NONE {
+        while closed[i as usize].parent != NONE {
             chain.push(i);
-            i = nodes[i as usize].parent;
+            i = closed[i as usize].parent;
         }
         chain.reverse();
         for &i in &chain {
-            let n = &nodes[i as usize];
-            let par = &nodes[n.parent as usize];
+            let n = &closed[i as usize];
+            let par = &closed[n.parent as usize];
             let cm = &p.contacts[n.contact as usize];
             let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize];
             plan.steps.push(Step {
@@ -661,7 +720,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             }
         }
         plan.found = true;
-        plan.cost = nodes[g as usize].cost;
+        plan.cost = closed[g as usize].cost;
         summarise(p, &mut plan);
     }
     plan.plan_time_ms = t0.elapsed().as_secs_f64() * 1e3;
