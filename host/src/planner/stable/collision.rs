@@ -140,6 +140,28 @@ impl Sat {
         }
     }
 
+    /// Whether this polygon, placed by `f`, is farther than `margin` from `o` (world frame)
+    /// along one of the edge normals of either polygon: then the polygon grown by a disk of
+    /// radius `margin` misses `o`. (Conservative: a gap only along another direction counts
+    /// as no gap.)
+    fn separated_by(&self, f: &Frame, o: &Sat, margin: f64) -> bool {
+        for (n, &off) in o.normals.iter().zip(&o.offsets) {
+            let nl = V2::new(f.c * n.x + f.s * n.y, -f.s * n.x + f.c * n.y);
+            let off_l = off - (n.x * f.x + n.y * f.y) + margin;
+            if self.pts.iter().all(|p| nl.dot(p) > off_l) {
+                return true;
+            }
+        }
+        for (n, &off) in self.normals.iter().zip(&self.offsets) {
+            let nw = V2::new(f.c * n.x - f.s * n.y, f.s * n.x + f.c * n.y);
+            let off_w = off + (nw.x * f.x + nw.y * f.y) + margin;
+            if o.pts.iter().all(|p| nw.dot(p) > off_w) {
+                return true;
+            }
+        }
+        false
+    }
+
     /// Whether this polygon, placed by `f`, overlaps `o` (world frame); touching overlaps.
     /// Exact separating-axis test over the edge normals of both polygons.
     fn overlaps(&self, f: &Frame, o: &Sat) -> bool {
@@ -206,15 +228,103 @@ impl World {
 /// Largest rotation between two samples of a swept shape (rad).
 const SWEPT_SAMPLE_ANGLE: f64 = 0.1;
 
+/// Pieces a step is cut into when its whole swept shape touches an obstacle.
+const SWEPT_PIECES: usize = 4;
+
+/// A conservative cover of what a [`Body`] sweeps over part of a step: per body part, the
+/// convex hull of the part at sampled poses, to be kept farther than `margin` (the largest
+/// sagitta of the arcs between samples and a small margin) from every obstacle.
+#[derive(Clone)]
+struct Cover {
+    parts: Vec<Sat>,
+    margin: f64,
+    /// Centre of a disk holding all parts grown by `margin` (slider frame at the step's start).
+    centre: V2,
+    /// Radius of that disk.
+    radius: f64,
+}
+
+impl Cover {
+    /// The cover of `body` over the motion `exp(t·xi)`, `t ∈ [t0, t1]`, from the slider
+    /// frame's identity pose.
+    fn new(body: &Body, xi: &V3, t0: f64, t1: f64) -> Self {
+        let phi = xi.z.abs() * (t1 - t0);
+        let (k, sag) = match super::cor_of(xi) {
+            Some(c) => {
+                let k = (phi / SWEPT_SAMPLE_ANGLE).ceil().max(1.0);
+                let rho = body
+                    .vertices
+                    .iter()
+                    .map(|v| (v - c).norm())
+                    .fold(0.0, f64::max);
+                (k as usize, rho * (1.0 - (phi / (2.0 * k)).cos()))
+            }
+            None => (1, 0.0),
+        };
+        // Arcs bulge beyond their chords by at most the sagitta; the margin on top makes "the
+        // grown hull misses every obstacle" imply "clearance > CONTACT_EPS all along".
+        let margin = sag + 3.0 * CONTACT_EPS;
+        let mut parts = Vec::new();
+        let mut all = Vec::new();
+        for pts in &body.part_points {
+            let mut cloud = Vec::with_capacity(pts.len() * (k + 1));
+            for i in 0..=k {
+                let t = t0 + (t1 - t0) * (i as f64 / k as f64);
+                let pose = Pose::new(0.0, 0.0, 0.0).integrate(&(xi * t));
+                cloud.extend(pts.iter().map(|p| pose.apply(*p)));
+            }
+            let hull = convex_hull(&cloud);
+            if convex(&hull).is_some() {
+                parts.push(Sat::new(&hull));
+                all.extend(hull);
+            }
+        }
+        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+        for p in &all {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let centre = (lo + hi) / 2.0;
+        let radius = all.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max) + margin;
+        Cover {
+            parts,
+            margin,
+            centre,
+            radius,
+        }
+    }
+
+    /// Whether the cover, placed by `f`, may touch an obstacle (`false`: it surely misses
+    /// them all by more than its margin). A bounding disk against each obstacle's box first.
+    fn hits(&self, world: &World, f: &Frame) -> bool {
+        let c = f.apply(self.centre);
+        let r2 = self.radius * self.radius;
+        world.obstacles.iter().any(|o| {
+            let b = o.bounds;
+            let dx = (b[0] - c.x).max(c.x - b[2]).max(0.0);
+            let dy = (b[1] - c.y).max(c.y - b[3]).max(0.0);
+            dx * dx + dy * dy <= r2
+                && self
+                    .parts
+                    .iter()
+                    .any(|part| !part.separated_by(f, &o.sat, self.margin))
+        })
+    }
+}
+
 /// A conservative swept shape, precomputed once per control: the region a [`Body`] covers
 /// while it follows a constant slider-frame twist from the slider frame's identity pose, as
-/// convex parts (one per body part: the hull of the part at sampled poses, grown by the largest
-/// sagitta of the arcs between samples and a small margin). Placed at a configuration `q` it
-/// contains everything the body touches during the step from `q`, so one static overlap test
-/// replaces the sweep when it misses.
+/// convex parts (one per body part: the hull of the part at sampled poses, kept a margin of the
+/// largest sagitta of the arcs between samples and a little more from the obstacles). Placed at
+/// a configuration `q` it contains everything the body touches during the step from `q`, so one
+/// static test replaces the sweep when it misses. When it does not, the same covers of
+/// [`SWEPT_PIECES`] pieces of the step (and the poses between them) are tried before the sweep.
 #[derive(Clone)]
 pub struct Swept {
-    parts: Vec<Sat>,
+    whole: Cover,
+    /// The pieces' covers, each with the pose at its end (`x`, `y`, `sin`, `cos`, slider frame
+    /// at the step's start).
+    pieces: Vec<(Cover, [f64; 4])>,
     /// Centre of a disk holding all parts (slider frame).
     pub centre: V2,
     /// Radius of that disk.
@@ -307,60 +417,31 @@ impl Body {
 
     /// The swept shape of this body under the slider-frame motion `xi` (see [`Swept`]).
     pub fn swept(&self, xi: &V3) -> Swept {
-        let phi = xi.z.abs();
-        let (k, sag) = match super::cor_of(xi) {
-            Some(c) => {
-                let k = (phi / SWEPT_SAMPLE_ANGLE).ceil().max(1.0);
-                let rho = self
-                    .vertices
-                    .iter()
-                    .map(|v| (v - c).norm())
-                    .fold(0.0, f64::max);
-                (k as usize, rho * (1.0 - (phi / (2.0 * k)).cos()))
-            }
-            None => (1, 0.0),
-        };
-        // Grow by the sagitta (arcs bulge beyond their chords) and a margin that makes "the
-        // grown hull misses every obstacle" imply "clearance > CONTACT_EPS all along".
-        let grow = (sag + 3.0 * CONTACT_EPS) / (std::f64::consts::PI / 8.0).cos();
-        let mut parts = Vec::new();
-        let mut all = Vec::new();
-        for pts in &self.part_points {
-            let mut cloud = Vec::with_capacity(pts.len() * (k + 1) * 8);
-            for i in 0..=k {
-                let pose = Pose::new(0.0, 0.0, 0.0).integrate(&(xi * (i as f64 / k as f64)));
-                for p in pts {
-                    let w = pose.apply(*p);
-                    for j in 0..8 {
-                        let a = std::f64::consts::PI * (2.0 * j as f64 + 1.0) / 8.0;
-                        cloud.push(w + V2::new(a.cos(), a.sin()) * grow);
-                    }
-                }
-            }
-            let hull = convex_hull(&cloud);
-            if convex(&hull).is_some() {
-                parts.push(Sat::new(&hull));
-                all.extend(hull);
-            }
-        }
-        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
-        for p in &all {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let centre = (lo + hi) / 2.0;
-        let radius = all.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+        let whole = Cover::new(self, xi, 0.0, 1.0);
+        let n = SWEPT_PIECES;
+        let pieces = (0..n)
+            .map(|i| {
+                let (t0, t1) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+                let end = Pose::new(0.0, 0.0, 0.0).integrate(&(xi * t1));
+                let (s, c) = end.theta.sin_cos();
+                (Cover::new(self, xi, t0, t1), [end.x, end.y, s, c])
+            })
+            .collect();
         Swept {
-            parts,
-            centre,
-            radius,
+            centre: whole.centre,
+            radius: whole.radius,
+            whole,
+            pieces,
         }
     }
 
     /// As [`Body::step_free`], deciding most steps with one static test of the precomputed
     /// swept shape `sw` of `xi`: if it misses every obstacle the step is free; else if the body
-    /// overlaps or touches an obstacle at the step's end the step is not; else conservative
-    /// advancement decides. The answer is the same as [`Body::step_free`]'s.
+    /// overlaps or touches an obstacle at the step's end the step is not; else the same test on
+    /// the step's pieces (free if all miss, not free if the body overlaps an obstacle where a
+    /// piece that does not miss ends); else conservative advancement decides. The answer is the
+    /// same as [`Body::step_free`]'s: a cover that misses keeps the body more than
+    /// `CONTACT_EPS` clear, and conservative advancement stops at any overlap.
     pub fn step_free_swept(&self, world: &World, q: &Pose, xi: &V3, sw: &Swept) -> bool {
         let end = q.integrate(xi);
         let sc = end.theta.sin_cos();
@@ -381,15 +462,7 @@ impl Body {
         end: &Pose,
         (se, ce): (f64, f64),
     ) -> bool {
-        let c = f.apply(sw.centre);
-        let r2 = sw.radius * sw.radius;
-        let hit = world.obstacles.iter().any(|o| {
-            let b = o.bounds;
-            let dx = (b[0] - c.x).max(c.x - b[2]).max(0.0);
-            let dy = (b[1] - c.y).max(c.y - b[3]).max(0.0);
-            dx * dx + dy * dy <= r2 && sw.parts.iter().any(|part| part.overlaps(f, &o.sat))
-        });
-        if !hit {
+        if !sw.whole.hits(world, f) {
             return true;
         }
         let fe = Frame {
@@ -400,6 +473,29 @@ impl Body {
         };
         if self.overlaps_in(world, &fe) || !self.free_at(world, end) {
             return false;
+        }
+        // The pieces: free if every piece's cover misses; not free if the body overlaps an
+        // obstacle between two pieces (conservative advancement would stop there too).
+        let mut missed = true;
+        for (i, (cover, [x, y, s, c])) in sw.pieces.iter().enumerate() {
+            if !cover.hits(world, f) {
+                continue;
+            }
+            missed = false;
+            if i + 1 < sw.pieces.len() {
+                let fi = Frame {
+                    x: f.x + f.c * x - f.s * y,
+                    y: f.y + f.s * x + f.c * y,
+                    s: f.s * c + f.c * s,
+                    c: f.c * c - f.s * s,
+                };
+                if self.overlaps_in(world, &fi) {
+                    return false;
+                }
+            }
+        }
+        if missed {
+            return true;
         }
         self.step_free_from(world, q, xi, None)
     }

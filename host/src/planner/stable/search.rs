@@ -12,7 +12,7 @@
 //! goal exactly.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap, VecDeque};
+use std::collections::{BinaryHeap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::time::Instant;
 
@@ -113,19 +113,31 @@ pub enum Checks {
     Lazy,
 }
 
-#[derive(Clone)]
-struct Node {
+/// A configuration taken from OPEN and expanded, or the goal: the search tree's inner nodes.
+#[derive(Clone, Copy)]
+struct Expanded {
     q: Pose,
+    /// `(sin θ, cos θ)` of `q` (its children's steps and checks use it).
+    sc: (f64, f64),
+    /// Whether `q` is in the refined region (§4.5): its children take the fine steps.
+    fine: bool,
     contact: u32,
     control: u32,
     parent: u32,
     cost: u32,
-    needs_transit: bool,
     transit: u32,
-    /// The step into this node still awaits its collision check ([`Checks::Lazy`]).
-    unchecked: bool,
-    /// `(sin θ, cos θ)` of `q`, set when the node is expanded (its children's checks use it).
-    sc: (f64, f64),
+}
+
+/// A generated step waiting in OPEN: control `control` of contact `contact` from the expanded
+/// node `parent` (`NONE`: the start itself), reaching cost `cost`. Its end configuration is
+/// recomputed from the parent when it is taken, with the same arithmetic, so bit for bit the
+/// one tested when it was generated; OPEN holds 16 bytes per entry.
+#[derive(Clone, Copy)]
+struct Pending {
+    parent: u32,
+    contact: u32,
+    control: u32,
+    cost: u32,
 }
 
 /// An admissible lower bound on the cost still to pay from a configuration to the goal
@@ -158,6 +170,10 @@ pub struct Heuristic {
     goal: Pose,
     goal_xy: f64,
     goal_theta: f64,
+    /// Largest rotation of one fine step.
+    turn_fine: f64,
+    /// Reciprocals of `step`, `fine_step`, `turn` and `turn_fine` (see [`Heuristic::quick`]).
+    inv: [f64; 4],
 }
 
 impl Heuristic {
@@ -177,20 +193,24 @@ impl Heuristic {
             0.0
         };
         let half_len = p.slider.length() / 2.0;
+        let turn = if half_len > 0.0 {
+            pa.step / half_len
+        } else {
+            f64::INFINITY
+        };
+        let turn_fine = turn * fine_step / pa.step;
         Heuristic {
             a: pa.a,
             step: pa.step,
             fine_step,
             fine_radius,
             fine_tail,
-            turn: if half_len > 0.0 {
-                pa.step / half_len
-            } else {
-                f64::INFINITY
-            },
+            turn,
             goal: p.goal,
             goal_xy: pa.goal_xy,
             goal_theta: pa.goal_theta,
+            turn_fine,
+            inv: [pa.step, fine_step, turn, turn_fine].map(|v| 1.0 / v),
         }
     }
 
@@ -202,40 +222,72 @@ impl Heuristic {
     /// the tail in) and the rest of the turning at the coarse rate; outside the disk the
     /// path ends with at least the fine tail.
     pub fn steps(&self, q: &Pose) -> u32 {
+        ceil_bound(self.raw::<true>(q))
+    }
+
+    /// [`Heuristic::steps`], bit for bit, multiplying by reciprocals instead of dividing; the
+    /// few configurations whose bound lands within `1e-7` of an integer (where the two
+    /// roundings could differ) are recomputed with the divisions.
+    fn quick(&self, q: &Pose) -> u32 {
+        let v = shrink(self.raw::<false>(q));
+        let t = floor(v);
+        let fr = v - t as f64;
+        if v.abs() < 1e6 && fr > 1e-7 && fr < 1.0 - 1e-7 {
+            // Not an integer: its ceiling is `t + 1`, and it is positive unless `t < 0`.
+            (t + 1).clamp(0, i64::from(u32::MAX)) as u32
+        } else {
+            self.steps(q)
+        }
+    }
+
+    /// The bound before rounding; `EXACT`: divide, else multiply by the reciprocals (the same
+    /// to a few units in the last place).
+    #[inline(always)]
+    fn raw<const EXACT: bool>(&self, q: &Pose) -> f64 {
+        // `x / d`, `d` being `step`, `fine_step`, `turn` or `turn_fine` (index `i`).
+        let div = |x: f64, d: f64, i: usize| if EXACT { x / d } else { x * self.inv[i] };
         let (dx, dy) = ((q.x - self.goal.x).abs(), (q.y - self.goal.y).abs());
         let (bx, by) = ((dx - self.goal_xy).max(0.0), (dy - self.goal_xy).max(0.0));
         let d_box = (bx * bx + by * by).sqrt();
         let d_centre = (dx * dx + dy * dy).sqrt();
         let turn = (super::angle_diff(q.theta, self.goal.theta).abs() - self.goal_theta).max(0.0);
-        let turn_fine = self.turn * self.fine_step / self.step;
+        let turn_fine = self.turn_fine;
         // Steps when `n_f` of them are fine and the rest of the turning is coarse.
-        let mixed = |n_f: f64| n_f + ((turn - n_f * turn_fine) / self.turn).max(0.0);
-        let n = if self.fine_radius <= 0.0 {
-            (d_box / self.step).max(turn / self.turn)
+        let mixed = |n_f: f64| n_f + div(turn - n_f * turn_fine, self.turn, 2).max(0.0);
+        if self.fine_radius <= 0.0 {
+            div(d_box, self.step, 0).max(div(turn, self.turn, 2))
         } else if d_centre > self.fine_radius {
             let tail = self.fine_tail;
-            (tail + ((d_box - tail * self.fine_step) / self.step).max(0.0)).max(mixed(tail))
+            (tail + div(d_box - tail * self.fine_step, self.step, 0).max(0.0)).max(mixed(tail))
         } else {
-            let all_fine = (d_box / self.fine_step).max(turn / turn_fine);
-            let out_and_back = (self.fine_radius - d_centre) / self.fine_step + self.fine_tail;
+            let all_fine = div(d_box, self.fine_step, 1).max(div(turn, turn_fine, 3));
+            let out_and_back = div(self.fine_radius - d_centre, self.fine_step, 1) + self.fine_tail;
             all_fine.min(out_and_back.max(mixed(out_and_back)))
-        };
-        // Round down, less a little for rounding errors: a bound, never more.
-        let v = n * (1.0 - 1e-9) - 1e-9;
-        // `v.ceil()` without the libm call (the hot loop's): truncate, then round up.
-        let t = v as i64;
-        let t = if (t as f64) < v {
-            t.saturating_add(1)
-        } else {
-            t
-        };
-        t.clamp(0, i64::from(u32::MAX)) as u32
+        }
     }
 
     /// The lower bound on the remaining cost: `a · steps`.
     pub fn cost(&self, steps: u32) -> u32 {
         self.a.saturating_mul(steps)
     }
+}
+
+/// A bound `n` less a little for rounding errors: rounded up, it is a bound, never more.
+fn shrink(n: f64) -> f64 {
+    n * (1.0 - 1e-9) - 1e-9
+}
+
+/// `shrink(n).ceil()` as a step count (at least 0), without the libm call: truncate, then
+/// round up.
+fn ceil_bound(n: f64) -> u32 {
+    let v = shrink(n);
+    let t = v as i64;
+    let t = if (t as f64) < v {
+        t.saturating_add(1)
+    } else {
+        t
+    };
+    t.clamp(0, i64::from(u32::MAX)) as u32
 }
 
 /// A cell key: `(x, y, θ, contact)` indices, `x` tagged for refined cells.
@@ -270,7 +322,8 @@ impl Block {
         let inside =
             (0..3).all(|j| i[j] >= 0 && i[j] < self.dim[j]) && (k.3 as i64) < self.contacts;
         inside.then(|| {
-            (((k.3 as i64 * self.dim[2] + i[2]) * self.dim[1] + i[1]) * self.dim[0] + i[0]) as usize
+            (((i[2] * self.dim[1] + i[1]) * self.dim[0] + i[0]) * self.contacts + k.3 as i64)
+                as usize
         })
     }
 }
@@ -364,21 +417,71 @@ pub fn plan(p: &Problem) -> Plan {
     plan_with(p, Queue::Buckets)
 }
 
-/// The grid cell of a configuration.
-fn cell(p: &Problem, q: &Pose, contact: u32) -> Key {
-    let th = super::wrap_2pi(q.theta);
-    // Refined cells near the goal carry a tag so they never share a key with coarse cells.
-    let (f, tag) = if p.near_goal(q) {
-        (p.params.fine_factor, 1i64 << 40)
+/// The grid's cell sizes and their reciprocals, for [`Cells::cell`] in the hot loop.
+struct Cells {
+    goal: (f64, f64),
+    fine_on: bool,
+    /// `fine_radius²`, as [`Problem::near_goal`] computes it.
+    r2: f64,
+    fine_factor: f64,
+    grid_xy: f64,
+    grid_theta: f64,
+    inv_xy: f64,
+    inv_theta: f64,
+}
+
+impl Cells {
+    fn new(p: &Problem) -> Self {
+        let pa = &p.params;
+        Cells {
+            goal: (p.goal.x, p.goal.y),
+            fine_on: pa.fine_factor > 1.0,
+            r2: pa.fine_radius * pa.fine_radius,
+            fine_factor: pa.fine_factor,
+            grid_xy: pa.grid_xy,
+            grid_theta: pa.grid_theta,
+            inv_xy: 1.0 / pa.grid_xy,
+            inv_theta: 1.0 / pa.grid_theta,
+        }
+    }
+
+    /// [`Problem::near_goal`], the same arithmetic.
+    fn near_goal(&self, q: &Pose) -> bool {
+        let (dx, dy) = (q.x - self.goal.0, q.y - self.goal.1);
+        self.fine_on && dx * dx + dy * dy <= self.r2
+    }
+
+    /// The grid cell of a configuration: refined cells near the goal carry a tag so they
+    /// never share a key with coarse cells.
+    fn cell(&self, q: &Pose, contact: u32) -> Key {
+        let th = super::wrap_2pi(q.theta);
+        let (f, tag) = if self.near_goal(q) {
+            (self.fine_factor, 1i64 << 40)
+        } else {
+            (1.0, 0)
+        };
+        (
+            floor_div(q.x * f, self.grid_xy, self.inv_xy) + tag,
+            floor_div(q.y * f, self.grid_xy, self.inv_xy),
+            floor_div(th * f, self.grid_theta, self.inv_theta),
+            contact,
+        )
+    }
+}
+
+/// `floor(y / d)`, bit for bit, given `inv = 1 / d`: for quotients below `10⁶`, `z = y · inv`
+/// is within `1e-9` of the quotient, so when `z` is positive and that far from an integer its
+/// truncation is the quotient's floor; otherwise (rare: negative, large, or close to an integer)
+/// the division is done.
+fn floor_div(y: f64, d: f64, inv: f64) -> i64 {
+    let z = y * inv;
+    let t = z as i64;
+    let fr = z - t as f64;
+    if fr > 1e-9 && fr < 1.0 - 1e-9 && z < 1e6 {
+        t
     } else {
-        (1.0, 0)
-    };
-    (
-        floor(q.x * f / p.params.grid_xy) + tag,
-        floor(q.y * f / p.params.grid_xy),
-        floor(th * f / p.params.grid_theta),
-        contact,
-    )
+        floor(y / d)
+    }
 }
 
 /// `x.floor() as i64` without the libm call: truncate, then round down.
@@ -409,50 +512,86 @@ pub fn step_cost(
     Some(c)
 }
 
-/// OPEN: the paper's cost-indexed FIFO lists, or one heap.
+/// One of the paper's FIFO lists: a vector read from `head` on.
+#[derive(Clone, Default)]
+struct Fifo {
+    items: Vec<Pending>,
+    head: usize,
+}
+
+/// OPEN: the paper's cost-indexed FIFO lists, or one heap (ordered by `(f, insertion order)`
+/// over a store of the entries).
 enum Open {
     Buckets {
-        lists: Vec<VecDeque<u32>>,
+        lists: Vec<Fifo>,
         cur: usize,
+        /// Emptied lists' buffers, reused by lists that fill up (fewer page faults and copies).
+        spare: Vec<Vec<Pending>>,
     },
-    Heap(BinaryHeap<Reverse<(u32, u32)>>),
+    Heap {
+        heap: BinaryHeap<Reverse<(u32, u32)>>,
+        store: Vec<Pending>,
+    },
 }
 
 impl Open {
-    fn push(&mut self, f: u32, id: u32) {
+    fn push(&mut self, f: u32, n: Pending) {
         match self {
-            Open::Buckets { lists, cur } => {
+            Open::Buckets { lists, cur, spare } => {
                 let f = f as usize;
-                if f < lists.len() {
-                    lists[f].push_back(id);
+                if let Some(l) = lists.get_mut(f) {
+                    if l.items.capacity() == 0
+                        && let Some(v) = spare.pop()
+                    {
+                        l.items = v;
+                    }
+                    l.items.push(n);
                     *cur = (*cur).min(f);
                 }
             }
-            Open::Heap(h) => h.push(Reverse((f, id))),
+            Open::Heap { heap, store } => {
+                heap.push(Reverse((f, store.len() as u32)));
+                store.push(n);
+            }
         }
     }
 
-    fn pop(&mut self) -> Option<u32> {
+    fn pop(&mut self) -> Option<Pending> {
         match self {
-            Open::Buckets { lists, cur } => {
-                while *cur < lists.len() {
-                    if let Some(id) = lists[*cur].pop_front() {
-                        return Some(id);
+            Open::Buckets { lists, cur, spare } => {
+                while let Some(l) = lists.get_mut(*cur) {
+                    if let Some(&n) = l.items.get(l.head) {
+                        l.head += 1;
+                        if l.head == l.items.len() {
+                            // Drained: keep its buffer for another list.
+                            let mut v = std::mem::take(&mut l.items);
+                            l.head = 0;
+                            v.clear();
+                            spare.push(v);
+                        }
+                        return Some(n);
                     }
                     *cur += 1;
                 }
                 None
             }
-            Open::Heap(h) => h.pop().map(|Reverse((_, id))| id),
+            Open::Heap { heap, store } => heap.pop().map(|Reverse((_, i))| store[i as usize]),
         }
     }
 }
 
 /// Whether the step of contact `ci`, control `k` from `from` (with `sc` = `(sin, cos)` of its
-/// angle) to `to` (`sc2` likewise) is free along its whole length.
-fn step_ok(p: &Problem, from: &Pose, sc: (f64, f64), ci: usize, k: usize, to: &Pose) -> bool {
+/// angle, `fine`: whether it is near the goal) to `to` is free along its whole length.
+fn step_ok(
+    p: &Problem,
+    from: &Pose,
+    (sc, fine): ((f64, f64), bool),
+    ci: usize,
+    k: usize,
+    to: &Pose,
+) -> bool {
     let cm = &p.contacts[ci];
-    let (xi, swept, (sd, cd)) = if p.near_goal(from) {
+    let (xi, swept, (sd, cd)) = if fine {
         (&cm.fine_steps[k], &cm.fine_swept[k], cm.fine_delta_sc[k])
     } else {
         (&cm.steps[k], &cm.swept[k], cm.delta_sc[k])
@@ -469,6 +608,32 @@ fn step_ok(p: &Problem, from: &Pose, sc: (f64, f64), ci: usize, k: usize, to: &P
         .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
 }
 
+/// The transit path (index into `transits`) of a mobile pusher from expanded node `parent`'s
+/// contact to `contact`, found once per pair (§4.6); `None` if there is none.
+fn transit_of(
+    p: &Problem,
+    closed: &[Expanded],
+    cache: &mut HashMap<(u32, u32), Option<u32>>,
+    transits: &mut Vec<TransitPath>,
+    parent: u32,
+    contact: u32,
+) -> Option<u32> {
+    *cache.entry((parent, contact)).or_insert_with(|| {
+        let par = &closed[parent as usize];
+        transit(
+            p,
+            &par.q,
+            par.contact as usize,
+            contact as usize,
+            closed.len() as u32,
+        )
+        .map(|tp| {
+            transits.push(tp);
+            (transits.len() - 1) as u32
+        })
+    })
+}
+
 /// Plan with the given OPEN list.
 ///
 /// A* on `f = g + h` ([`Heuristic`]). The paper prunes a configuration whose grid cell was
@@ -483,78 +648,104 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
 pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();
     let heur = Heuristic::new(p);
-    let mut nodes: Vec<Node> = vec![Node {
-        q: p.start,
-        contact: p.start_contact.map_or(NONE, |c| c as u32),
-        control: NONE,
-        parent: NONE,
-        cost: 0,
-        needs_transit: false,
-        transit: NONE,
-        unchecked: false,
-        sc: (0.0, 1.0),
-    }];
+    // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
+    let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
     let mut occupied = Grid::new(p);
+    let cells = Cells::new(p);
     let max_cost = p.params.max_cost;
     let mut open = match queue {
         Queue::Buckets => Open::Buckets {
-            lists: vec![VecDeque::new(); max_cost as usize + 1],
+            lists: vec![Fifo::default(); max_cost as usize + 1],
             cur: 0,
+            spare: Vec::new(),
         },
-        Queue::Heap => Open::Heap(BinaryHeap::new()),
+        Queue::Heap => Open::Heap {
+            heap: BinaryHeap::new(),
+            store: Vec::new(),
+        },
     };
-    open.push(heur.cost(heur.steps(&p.start)), 0);
+    let start_contact = p.start_contact.map_or(NONE, |c| c as u32);
+    open.push(
+        heur.cost(heur.steps(&p.start)),
+        Pending {
+            parent: NONE,
+            contact: start_contact,
+            control: NONE,
+            cost: 0,
+        },
+    );
     let heur_zero = heur.cost(u32::MAX) == 0;
+    let lazy = checks == Checks::Lazy;
+    let mobile = p.pusher.is_mobile();
     let mut expanded = 0usize;
     let mut goal_node = None;
     // The start must be free for some contact's body; each step checks its own body.
-    while let Some(id) = open.pop() {
-        let n = nodes[id as usize].clone();
+    while let Some(n) = open.pop() {
+        // The configuration: the start, or the parent's step (as when it was generated).
+        let q = if n.parent == NONE {
+            p.start
+        } else {
+            let par = &closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let d = if par.fine {
+                &cm.fine_deltas[n.control as usize]
+            } else {
+                &cm.deltas[n.control as usize]
+            };
+            par.q.compose(d, par.sc)
+        };
         // The node's grid cell (the start, with no contact yet, has none).
-        let key = (n.contact != NONE).then(|| cell(p, &n.q, n.contact));
-        let in_goal = p.in_goal(&n.q);
-        if n.unchecked {
+        let key = (n.contact != NONE).then(|| cells.cell(&q, n.contact));
+        let in_goal = p.in_goal(&q);
+        if lazy && n.parent != NONE {
             // Pruned at the grid test below anyway (unless it is a goal): skip the check.
             if !in_goal && key.is_some_and(|k| occupied.get(k) <= n.cost) {
                 continue;
             }
-            let par = &nodes[n.parent as usize];
+            let par = &closed[n.parent as usize];
             if !step_ok(
                 p,
                 &par.q,
-                par.sc,
+                (par.sc, par.fine),
                 n.contact as usize,
                 n.control as usize,
-                &n.q,
+                &q,
             ) {
                 continue;
             }
         }
-        if n.needs_transit {
-            let key = (n.parent, n.contact);
-            let t = *transit_cache.entry(key).or_insert_with(|| {
-                let par = &nodes[n.parent as usize];
-                transit(
+        let mut transit_id = NONE;
+        if mobile && n.parent != NONE {
+            let par_contact = closed[n.parent as usize].contact;
+            if par_contact != NONE && par_contact != n.contact {
+                match transit_of(
                     p,
-                    &par.q,
-                    par.contact as usize,
-                    n.contact as usize,
-                    nodes.len() as u32,
-                )
-                .map(|tp| {
-                    transits.push(tp);
-                    (transits.len() - 1) as u32
-                })
-            });
-            match t {
-                Some(ti) => nodes[id as usize].transit = ti,
-                None => continue,
+                    &closed,
+                    &mut transit_cache,
+                    &mut transits,
+                    n.parent,
+                    n.contact,
+                ) {
+                    Some(ti) => transit_id = ti,
+                    None => continue,
+                }
             }
         }
+        let node = Expanded {
+            q,
+            sc: (0.0, 1.0),
+            fine: false,
+            contact: n.contact,
+            control: n.control,
+            parent: n.parent,
+            cost: n.cost,
+            transit: transit_id,
+        };
         if in_goal {
-            goal_node = Some(id);
+            closed.push(node);
+            goal_node = Some((closed.len() - 1) as u32);
             break;
         }
         if let Some(key) = key {
@@ -575,12 +766,11 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 n.control as usize
             },
         ));
-        let sc = n.q.theta.sin_cos();
-        nodes[id as usize].sc = sc;
-        let fine = p.near_goal(&n.q);
-        let lazy = checks == Checks::Lazy;
-        for ci in 0..p.contacts.len() {
-            let cm = &p.contacts[ci];
+        let sc = q.theta.sin_cos();
+        let fine = cells.near_goal(&q);
+        let me = closed.len() as u32;
+        closed.push(Expanded { sc, fine, ..node });
+        for (ci, cm) in p.contacts.iter().enumerate() {
             let deltas = if fine { &cm.fine_deltas } else { &cm.deltas };
             for (k, delta) in deltas.iter().enumerate() {
                 let Some(dc) = step_cost(p, prev, ci, k) else {
@@ -590,36 +780,32 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 if cost > max_cost {
                     continue;
                 }
-                let q2 = n.q.compose(delta, sc);
+                let q2 = q.compose(delta, sc);
                 // Both tests only filter; the grid's, more selective, goes first. With `a = 0`
                 // the bound is 0 and is not computed.
-                if occupied.get(cell(p, &q2, ci as u32)) <= cost {
+                if occupied.get(cells.cell(&q2, ci as u32)) <= cost {
                     continue;
                 }
                 let f = if heur_zero {
                     cost
                 } else {
-                    cost.saturating_add(heur.cost(heur.steps(&q2)))
+                    cost.saturating_add(heur.cost(heur.quick(&q2)))
                 };
                 if f > max_cost {
                     continue;
                 }
-                if !lazy && !step_ok(p, &n.q, sc, ci, k, &q2) {
+                if !lazy && !step_ok(p, &q, (sc, fine), ci, k, &q2) {
                     continue;
                 }
-                let needs_transit = p.pusher.is_mobile() && prev.is_some_and(|(pc, _)| pc != ci);
-                nodes.push(Node {
-                    q: q2,
-                    contact: ci as u32,
-                    control: k as u32,
-                    parent: id,
-                    cost,
-                    needs_transit,
-                    transit: NONE,
-                    unchecked: lazy,
-                    sc: (0.0, 1.0),
-                });
-                open.push(f, (nodes.len() - 1) as u32);
+                open.push(
+                    f,
+                    Pending {
+                        parent: me,
+                        contact: ci as u32,
+                        control: k as u32,
+                        cost,
+                    },
+                );
             }
         }
     }
@@ -638,14 +824,14 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     if let Some(g) = goal_node {
         let mut chain = Vec::new();
         let mut i = g;
-        while nodes[i as usize].parent != NONE {
+        while closed[i as usize].parent != NONE {
             chain.push(i);
-            i = nodes[i as usize].parent;
+            i = closed[i as usize].parent;
         }
         chain.reverse();
         for &i in &chain {
-            let n = &nodes[i as usize];
-            let par = &nodes[n.parent as usize];
+            let n = &closed[i as usize];
+            let par = &closed[n.parent as usize];
             let cm = &p.contacts[n.contact as usize];
             let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize];
             plan.steps.push(Step {
@@ -661,7 +847,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             }
         }
         plan.found = true;
-        plan.cost = nodes[g as usize].cost;
+        plan.cost = closed[g as usize].cost;
         summarise(p, &mut plan);
     }
     plan.plan_time_ms = t0.elapsed().as_secs_f64() * 1e3;
