@@ -11,7 +11,7 @@ use pushbot::mechanics::stable::stable;
 use pushbot::mechanics::{V2, V3, cor};
 use pushbot::planner::stable::presets::{CostOverride, PRESETS, load_scene, scene_from_toml};
 use pushbot::planner::stable::pusher::PusherKind;
-use pushbot::planner::stable::search::{Heuristic, Plan, brute_force_cost, exact_goal};
+use pushbot::planner::stable::search::{Heuristic, Plan, brute_force_cost, exact_goal, step_cost};
 use pushbot::planner::stable::{Pose, Problem, Queue, angle_diff, plan, plan_with};
 
 /// Separating-axis overlap test of two convex polygons (closed: touching overlaps).
@@ -528,6 +528,89 @@ fn heuristic_is_a_lower_bound_along_found_plans() {
         // And it is not trivial: from the start it needs a good part of the plan's steps.
         let b0 = h.steps(&p.start) as usize;
         assert!(b0 >= 3 && b0 <= n, "{name}: bound {b0} of {n} steps");
+        // The whole bound, with its control-change term, never exceeds the cost the plan
+        // still pays after each step.
+        let mut rest = pl.cost;
+        let mut prev = p.start_contact.map(|c| (c, usize::MAX));
+        for (i, s) in pl.steps.iter().enumerate() {
+            rest -= step_cost(&p, prev, s.contact, s.control).unwrap();
+            prev = Some((s.contact, s.control));
+            let turn = h.turns(&s.to, s.to.theta.sin_cos(), s.contact, s.control);
+            let bound = h.cost(h.steps(&s.to)) + if turn { p.params.b } else { 0 };
+            assert!(
+                bound <= rest,
+                "{name}: after step {i}: bound {bound} > the {rest} still paid"
+            );
+        }
+        assert_eq!(rest, 0, "{name}: the plan's cost is the sum of its steps'");
+    }
+}
+
+/// The control-change term of the bound (`Heuristic::turns`) claims only curves that miss the
+/// goal neighbourhood: following a control it says misses, sampled finely over a whole turn
+/// (or 3 m of translation), never enters it; for configurations backed up along a control
+/// from inside the neighbourhood, whose curve does enter, it never says miss.
+#[test]
+fn control_change_bound_only_claims_curves_that_miss_the_goal() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    for name in ["fig13", "fig15", "fig16"] {
+        let p = load_scene(name)
+            .unwrap()
+            .problem(CostOverride::default())
+            .unwrap();
+        let h = Heuristic::new(&p);
+        let (gx, gt) = (p.params.goal_xy, p.params.goal_theta);
+        let (mut misses, mut entering) = (0, 0);
+        for i in 0..600 {
+            let ci = rng.random_range(0..p.contacts.len());
+            let k = rng.random_range(0..p.contacts[ci].steps.len());
+            let xi = p.contacts[ci].steps[k];
+            // Length of the curve in step units: a whole turn, or 3 m.
+            let span = if xi.z.abs() > 1e-12 {
+                2.0 * std::f64::consts::PI / xi.z.abs()
+            } else {
+                3.0 / xi.x.hypot(xi.y)
+            };
+            let q = if i % 2 == 0 {
+                Pose::new(
+                    p.goal.x + rng.random_range(-0.4..0.4),
+                    p.goal.y + rng.random_range(-0.4..0.4),
+                    p.goal.theta + rng.random_range(-1.5..1.5),
+                )
+            } else {
+                // From a pose inside the neighbourhood, back along the control.
+                let inside = Pose::new(
+                    p.goal.x + rng.random_range(-gx..gx) * 0.99,
+                    p.goal.y + rng.random_range(-gx..gx) * 0.99,
+                    p.goal.theta + rng.random_range(-gt..gt) * 0.99,
+                );
+                assert!(p.in_goal(&inside));
+                inside.integrate(&(xi * -rng.random_range(0.0..span.min(20.0))))
+            };
+            let turn = h.turns(&q, q.theta.sin_cos(), ci, k);
+            let n = 20_000;
+            let enters =
+                (0..=n).any(|j| p.in_goal(&q.integrate(&(xi * (span * j as f64 / n as f64)))));
+            if i % 2 == 1 {
+                assert!(
+                    !turn,
+                    "{name}: q {q:?} control {ci}/{k} enters the goal, bound says miss"
+                );
+                entering += 1;
+            }
+            if turn {
+                assert!(
+                    !enters,
+                    "{name}: q {q:?} control {ci}/{k}: said miss, but enters"
+                );
+                misses += 1;
+            }
+        }
+        assert!(
+            misses > 100 && entering > 100,
+            "{name}: {misses} misses, {entering} entering"
+        );
     }
 }
 

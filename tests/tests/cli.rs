@@ -242,15 +242,60 @@ fn exact_goal_finishes_a_car_plan_and_says_clearly_when_nothing_finishes() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["found"], true, "{v}");
     assert_eq!(v["exact_goal"], true, "{v}");
-    // Fig. 16's arm plan has no configuration from which one stable push ends on the goal:
-    // a failure (exit 1) with the reason, as JSON on stdout.
-    let out = run("fig16");
+    // Fig. 16's slot with the goal moved 5 mm into the right-hand obstacle: the goal
+    // neighbourhood (±2 cm) has free room, so a plan is found, but no push can end exactly
+    // on the goal. A failure (exit 1) with the reason, as JSON on stdout.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("fig16-wall.toml");
+    std::fs::write(&scene, FIG16_GOAL_IN_WALL).expect("write scene");
+    let out = run(scene.to_str().expect("UTF-8 path"));
     assert_eq!(out.status.code(), Some(1), "{out:?}");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert!(
         v["error"]["message"]
             .as_str()
-            .is_some_and(|m| m.contains("no exact finish")),
+            .is_some_and(|m| m.contains("no exact finish")
+                && m.contains("goal configuration itself is not free")),
         "{v}"
     );
+    // Without --exact-goal the same scene plans into the neighbourhood.
+    let out = std::process::Command::new(pushbot_tests::bin("pushbot"))
+        .args(["--json", "plan", "stable", "--scene"])
+        .arg(&scene)
+        .output()
+        .expect("run pushbot");
+    assert!(out.status.success(), "{out:?}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(v["found"], true, "{v}");
 }
+
+/// Fig. 16's scene with the goal 11.2 cm right of the slot's centre: at the goal's heading
+/// (90°) the slider's right side is at x = 0.855, 5 mm inside the obstacle that starts at 0.85.
+const FIG16_GOAL_IN_WALL: &str = r#"name = "fig16-goal-in-wall"
+[table]
+width = 1.2
+height = 0.8
+[robot]
+start = { x = 0.8, y = 0.2, theta = 1.5708 }
+[[obstacles]]
+outline = [[0.0, 0.45], [0.5, 0.45], [0.5, 0.8], [0.0, 0.8]]
+[[obstacles]]
+outline = [[0.85, 0.45], [1.2, 0.45], [1.2, 0.8], [0.85, 0.8]]
+[[objects]]
+id = "slider"
+outline = [[-0.09691358024691357, -0.06790123456790124], [0.10308641975308644, -0.06790123456790124], [0.10308641975308644, 0.03209876543209876], [0.05308641975308642, 0.07209876543209877], [-0.09691358024691357, 0.07209876543209877]]
+pose = { x = 0.25, y = 0.2, theta = 0.0 }
+mass = 0.1
+support_friction = 0.3
+pusher_friction = 0.5
+[[goals]]
+object = "slider"
+pose = { x = 0.787, y = 0.62, theta = 1.5707963267948966 }
+[stable]
+object = "slider"
+edges = [0, 3]
+goal_xy_frac = 0.1
+goal_theta_deg = 2.0
+pusher = { kind = "arm" }
+planner = { a = 1, b = 5, c = 0, step_frac = 0.3, grid_xy_frac = 1.0, grid_theta_deg = 6.0, fine_radius_frac = 0.65, fine_factor = 3.0, max_cost = 3000, max_nodes = 300000 }
+"#;

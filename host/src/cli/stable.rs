@@ -55,6 +55,9 @@ pub struct BenchStableArgs {
     /// Runs per preset (the median is reported).
     #[arg(long, default_value_t = 5)]
     pub repeat: usize,
+    /// Only these presets (repeatable; default: all of them).
+    #[arg(long = "preset", value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(PRESETS))]
+    pub presets: Vec<String>,
 }
 
 fn fmt_dir(v: &crate::mechanics::V3) -> serde_json::Value {
@@ -172,8 +175,18 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
                 p = e;
             }
             None => {
+                // The goal neighbourhood may have room where the exact goal has none.
+                let goal_blocked = problem
+                    .contacts
+                    .iter()
+                    .all(|cm| !cm.body.free_at(&problem.world, &problem.goal));
+                let why = if goal_blocked {
+                    "the goal configuration itself is not free: there the slider (with the pusher on any of its contacts) overlaps an obstacle or leaves the table"
+                } else {
+                    "neither one stable push nor a Dubins path of stable pushes (wheeled pushers) is free of collision from any configuration of the plan"
+                };
                 return Err(CliError::Failed(anyhow::anyhow!(
-                    "no exact finish reaches the goal: neither one stable push nor a Dubins path of stable pushes (wheeled pushers) is free of collision from any configuration of the plan"
+                    "no exact finish reaches the goal: {why}"
                 )));
             }
         }
@@ -234,6 +247,9 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
     let mut rows = Vec::new();
     let mut all_found = true;
     for (name, paper) in PRESETS.iter().zip(PAPER_SECONDS) {
+        if !a.presets.is_empty() && !a.presets.iter().any(|p| p == name) {
+            continue;
+        }
         let scene = load_scene(name).map_err(CliError::BadInput)?;
         let problem = scene
             .problem(CostOverride::default())

@@ -28,6 +28,14 @@ pub const PLATE_WIDTH: f64 = 0.12;
 pub const PLATE_OFFSET: f64 = 0.06;
 /// Pushing speed of the axle centre (m/s): slow, as quasi-static pushing assumes.
 pub const SPEED: f64 = 0.04;
+/// The robot problem's grid cell in x, y, as a fraction of the step. Lynch & Mason §4.2.4 ask
+/// for a grid fine enough that every control moves the configuration to a new cell: the robot
+/// turns about centres on its axle, half a metre out, so a step turns the slider only about as
+/// much as one 6° cell and moves its centre about one step; with cells of a whole step a
+/// diagonal step can stay in its cell and be pruned. Half a step always leaves it. (With whole
+/// steps the search for Fig. 13 on one edge finds a plan or not depending on the order it
+/// expands equal-cost configurations in.)
+pub const ROBOT_GRID_XY_FRAC: f64 = 0.5;
 
 /// The preset `name` with its pusher replaced by the plated differential-drive robot, edge 0
 /// only (no contact changes), with the goal heading `goal_theta_deg` (if given); and the problem
@@ -40,7 +48,7 @@ pub fn robot_problem(name: &str, goal_theta_deg: Option<f64>) -> Result<(StableS
 /// robot, pushing on the slider edges `edges` (any of them first), a contact change costing
 /// `contact_cost` (`None`: ∞, no contact changes), with the goal heading tolerance
 /// `goal_theta_deg` (if given); and the problem built from it. The preset's other costs and
-/// search settings are kept.
+/// search settings are kept, but for the grid's cell in x, y: half a step ([`ROBOT_GRID_XY_FRAC`]).
 pub fn robot_problem_edges(
     name: &str,
     goal_theta_deg: Option<f64>,
@@ -65,6 +73,7 @@ pub fn robot_problem_edges(
     s.pusher.min_turning_radius = None;
     s.task.edges = edges.to_vec();
     s.task.start_edge = None;
+    s.planner.grid_xy_frac = Some(ROBOT_GRID_XY_FRAC);
     s.planner.c = Some(match contact_cost {
         Some(c) => CostSpec::Int(c),
         None => CostSpec::Word("inf".into()),

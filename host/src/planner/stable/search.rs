@@ -19,7 +19,7 @@ use std::time::Instant;
 use super::collision::Frame;
 use super::transit::{TransitPath, transit};
 use super::{Pose, Problem};
-use crate::mechanics::V3;
+use crate::mechanics::{V2, V3};
 
 const NONE: u32 = u32::MAX;
 
@@ -117,7 +117,8 @@ pub enum Checks {
 #[derive(Clone, Copy)]
 struct Expanded {
     q: Pose,
-    /// `(sin θ, cos θ)` of `q` (its children's steps and checks use it).
+    /// `(sin θ, cos θ)` of `q` (its children's steps and checks use it): the parent's composed
+    /// with the step's rotation, as [`step_ok`] does for the step's end.
     sc: (f64, f64),
     /// Whether `q` is in the refined region (§4.5): its children take the fine steps.
     fine: bool,
@@ -141,25 +142,35 @@ struct Pending {
 }
 
 /// An admissible lower bound on the cost still to pay from a configuration to the goal
-/// neighbourhood: `a` times a lower bound on the number of push steps. It turns the paper's
-/// best-first search (§4.1) into A* without changing what it minimises.
+/// neighbourhood: `a` times a lower bound on the number of push steps, plus `b` when a control
+/// change is surely due. It turns the paper's best-first search (§4.1) into A* without
+/// changing what it minimises.
 ///
-/// Why it is a lower bound: a step of length `step` moves no slider vertex farther than
-/// `step` along its arc, so the centre of friction (inside the convex hull of the vertices,
-/// hence no farther from the rotation centre than some vertex) moves at most `step`, and the
-/// slider turns at most `step / R` with `R` = half the slider length (every point has a vertex
-/// at least that far away). Steps that start within `fine_radius` of the goal are `fine_factor`
-/// times shorter (§4.5): after the last step that starts outside that disk the centre is still
-/// at least `fine_radius − step` from the goal, and the goal box lies within `goal_xy·√2` of it.
-/// Fine steps also turn `fine_factor` times less, so the turning still to do is bounded with
-/// the same split into fine and coarse steps (see [`Heuristic::steps`]).
+/// Why the step count is a lower bound: a step of length `step` moves no slider vertex farther
+/// than `step` along its arc, so the centre of friction (inside the convex hull of the
+/// vertices, hence no farther from the rotation centre than some vertex) moves at most `step`.
+/// Every step of a control turns the slider by the same angle, so no step turns it more than
+/// the largest of the controls' step rotations (the problem's own steps, precomputed; at most
+/// `step / R` with `R` = half the slider length, as every point has a vertex at least that far
+/// away). Steps that start within `fine_radius` of the goal are `fine_factor` times shorter
+/// (§4.5): after the last step that starts outside that disk the centre is still at least
+/// `fine_radius − step` from the goal, and the goal box lies within `goal_xy·√2` of it. Fine
+/// steps turn by their own (smaller) largest rotation, so the turning still to do is bounded
+/// with the same split into fine and coarse steps (see [`Heuristic::steps`]).
 ///
-/// (A bound on control changes — "this control's curve misses the goal, so a change costing
-/// `b` is due" — is admissible too, but it reorders the search enough that the grid pruning of
-/// §4.2.3 loses Fig. 13's plan for the differential drive, so it is not used.)
+/// The control-change term: a configuration reached with control `k` of a contact reaches the
+/// goal neighbourhood without another control change only along the curve that repeating `k`
+/// traces (a circle about the control's fixed rotation centre, or a ray; refined steps near
+/// the goal follow the same curve). If that curve never enters the neighbourhood, at least one
+/// more control change, costing `b`, is due ([`Heuristic::turns`]). Steps and control changes
+/// are separate terms of the cost, so the sum is still a bound; and it is consistent: a step
+/// that keeps the control stays on the curve, one that changes it pays `b`.
 #[derive(Debug, Clone)]
 pub struct Heuristic {
     a: u32,
+    b: u32,
+    /// Per contact, per control: its curve in the slider frame.
+    curves: Vec<Vec<Curve>>,
     step: f64,
     fine_step: f64,
     fine_radius: f64,
@@ -193,14 +204,52 @@ impl Heuristic {
             0.0
         };
         let half_len = p.slider.length() / 2.0;
-        let turn = if half_len > 0.0 {
+        let turn_any = if half_len > 0.0 {
             pa.step / half_len
         } else {
             f64::INFINITY
         };
-        let turn_fine = turn * fine_step / pa.step;
+        // The largest rotation of one step of any control (each bounded by `turn_any`);
+        // kept above 0 so that "cannot turn" reads as an unreachable heading, not a NaN.
+        let max_turn = |deltas: fn(&super::ContactModel) -> &[Pose], cap: f64| {
+            p.contacts
+                .iter()
+                .flat_map(|cm| deltas(cm).iter())
+                .map(|d| d.theta.abs())
+                .fold(0.0f64, f64::max)
+                .min(cap)
+                .max(1e-12)
+        };
+        let turn = max_turn(|cm| &cm.deltas, turn_any);
+        let turn_fine = if fine_on {
+            max_turn(|cm| &cm.fine_deltas, turn_any * fine_step / pa.step)
+        } else {
+            turn
+        };
+        let (sg, cg) = p.goal.theta.sin_cos();
+        let curves = p
+            .contacts
+            .iter()
+            .map(|cm| {
+                cm.steps
+                    .iter()
+                    .map(|xi| match super::cor_of(xi) {
+                        Some(c) => Curve::Turn {
+                            cor: c,
+                            cor_at_goal: V2::new(cg * c.x - sg * c.y, sg * c.x + cg * c.y),
+                            radius: c.norm(),
+                        },
+                        None => Curve::Line {
+                            dir: V2::new(xi.x, xi.y),
+                        },
+                    })
+                    .collect()
+            })
+            .collect();
         Heuristic {
             a: pa.a,
+            b: pa.b,
+            curves,
             step: pa.step,
             fine_step,
             fine_radius,
@@ -270,6 +319,79 @@ impl Heuristic {
     pub fn cost(&self, steps: u32) -> u32 {
         self.a.saturating_mul(steps)
     }
+
+    /// Whether a configuration `q` (with `(sin θ, cos θ)` = `sc`) reached with control
+    /// `control` of contact `contact` needs at least one more control change: repeating the
+    /// control traces a curve that never enters the goal neighbourhood (tested with a margin,
+    /// so it errs towards `false`).
+    pub fn turns(&self, q: &Pose, (s, c): (f64, f64), contact: usize, control: usize) -> bool {
+        const EPS: f64 = 1e-9;
+        let Some(curve) = self.curves.get(contact).and_then(|v| v.get(control)) else {
+            return false;
+        };
+        let (gx, gy, r) = (self.goal.x, self.goal.y, self.goal_xy);
+        match *curve {
+            Curve::Turn {
+                cor,
+                cor_at_goal,
+                radius,
+            } => {
+                // On the circle about the world rotation centre `q.apply(cor)`, the pose with
+                // the goal's heading is `m = q + R(θ)·cor − R(θ_goal)·cor`; poses with a
+                // heading within `goal_theta` of it lie within `radius·goal_theta` of `m`.
+                let mx = q.x + c * cor.x - s * cor.y - cor_at_goal.x;
+                let my = q.y + s * cor.x + c * cor.y - cor_at_goal.y;
+                let dx = ((mx - gx).abs() - r).max(0.0);
+                let dy = ((my - gy).abs() - r).max(0.0);
+                let tol = radius * self.goal_theta + EPS;
+                dx * dx + dy * dy > tol * tol
+            }
+            Curve::Line { dir } => {
+                if super::angle_diff(q.theta, self.goal.theta).abs() > self.goal_theta + EPS {
+                    return true;
+                }
+                // Slab test of the ray `q + t·d`, t ≥ 0, against the goal box.
+                let d = V2::new(c * dir.x - s * dir.y, s * dir.x + c * dir.y);
+                let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+                for (o, d, g) in [(q.x, d.x, gx), (q.y, d.y, gy)] {
+                    let (lo, hi) = (g - r - EPS, g + r + EPS);
+                    if d.abs() < 1e-15 {
+                        if o < lo || o > hi {
+                            return true;
+                        }
+                    } else {
+                        let (a, b) = ((lo - o) / d, (hi - o) / d);
+                        t0 = t0.max(a.min(b));
+                        t1 = t1.min(a.max(b));
+                    }
+                }
+                t0 > t1
+            }
+        }
+    }
+
+    /// The control-change term of the bound: `b` if [`Heuristic::turns`], else 0.
+    fn turn_cost(&self, q: &Pose, sc: (f64, f64), contact: usize, control: usize) -> u32 {
+        if self.b > 0 && self.turns(q, sc, contact, control) {
+            self.b
+        } else {
+            0
+        }
+    }
+}
+
+/// The curve a control traces when repeated.
+#[derive(Debug, Clone, Copy)]
+enum Curve {
+    /// A rotation about `cor` (slider frame); `cor_at_goal` is `cor` rotated by the goal's
+    /// heading; `radius = |cor|`.
+    Turn {
+        cor: V2,
+        cor_at_goal: V2,
+        radius: f64,
+    },
+    /// A translation along `dir` (slider frame).
+    Line { dir: V2 },
 }
 
 /// A bound `n` less a little for rounding errors: rounded up, it is a bound, never more.
@@ -603,9 +725,15 @@ fn step_ok(
         c: sc.1,
     };
     // `(sin, cos)` at the step's end, composed from the start's and the step's rotation.
-    let sc2 = (sc.0 * cd + sc.1 * sd, sc.1 * cd - sc.0 * sd);
+    let sc2 = compose_sc(sc, (sd, cd));
     cm.body
         .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
+}
+
+/// `(sin, cos)` of the sum of two angles given as `(sin, cos)`.
+#[inline(always)]
+fn compose_sc((s, c): (f64, f64), (sd, cd): (f64, f64)) -> (f64, f64) {
+    (s * cd + c * sd, c * cd - s * sd)
 }
 
 /// The transit path (index into `transits`) of a mobile pusher from expanded node `parent`'s
@@ -677,6 +805,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
         },
     );
     let heur_zero = heur.cost(u32::MAX) == 0;
+    let start_sc = p.start.theta.sin_cos();
     let lazy = checks == Checks::Lazy;
     let mobile = p.pusher.is_mobile();
     let mut expanded = 0usize;
@@ -766,7 +895,18 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 n.control as usize
             },
         ));
-        let sc = q.theta.sin_cos();
+        let sc = if n.parent == NONE {
+            start_sc
+        } else {
+            let par = &closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let (sd, cd) = if par.fine {
+                cm.fine_delta_sc[n.control as usize]
+            } else {
+                cm.delta_sc[n.control as usize]
+            };
+            compose_sc(par.sc, (sd, cd))
+        };
         let fine = cells.near_goal(&q);
         let me = closed.len() as u32;
         closed.push(Expanded { sc, fine, ..node });
@@ -791,6 +931,8 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 } else {
                     cost.saturating_add(heur.cost(heur.quick(&q2)))
                 };
+                // The curve of control `k` through `q2` is the one through `q`.
+                let f = f.saturating_add(heur.turn_cost(&q, sc, ci, k));
                 if f > max_cost {
                     continue;
                 }
