@@ -19,7 +19,7 @@ use dubins_paths::SegmentType;
 use dubins_paths::f64::{DubinsPath, PosRot};
 
 use super::pusher::PusherKind;
-use super::search::{self, Plan, Step, summarise};
+use super::search::{self, Plan, backed_up, push_steps, summarise};
 use super::{Pose, Problem};
 use crate::mechanics::{V2, V3};
 
@@ -149,39 +149,6 @@ fn dubins_finishes(p: &Problem, ci: usize, q: &Pose, goal: &Pose) -> Vec<Vec<Pus
         .collect()
 }
 
-/// The steps of `pushes` with contact `ci` from `q`, each push cut into steps of the problem's
-/// step length (so the cost counts them as the search counts steps); the last step ends on
-/// `goal` exactly.
-fn steps_of(p: &Problem, ci: usize, q: &Pose, pushes: &[Push], goal: &Pose) -> Vec<Step> {
-    let cm = &p.contacts[ci];
-    let mut out = Vec::new();
-    let mut at = *q;
-    for (j, push) in pushes.iter().enumerate() {
-        let unit = super::step_twist(&p.slider, &push.xi, p.params.step);
-        let n = (push.xi.norm() / unit.norm()).ceil().max(1.0) as usize;
-        let tw = push.xi / n as f64;
-        for k in 0..n {
-            let from = at.integrate(&(push.xi * (k as f64 / n as f64)));
-            let last = j + 1 == pushes.len() && k + 1 == n;
-            let to = if last {
-                *goal
-            } else {
-                at.integrate(&(push.xi * ((k + 1) as f64 / n as f64)))
-            };
-            out.push(Step {
-                contact: ci,
-                edge: cm.edge,
-                control: push.control,
-                from,
-                to,
-                twist: [tw.x, tw.y, tw.z],
-            });
-        }
-        at = at.integrate(&push.xi);
-    }
-    out
-}
-
 /// The exact-goal finish of §4.5 for a wheeled pusher (see the module doc): back up along
 /// `plan` until a configuration from which a Dubins path of pushes with the contact in use ends
 /// collision-free exactly on the goal; of the finishes from the first such configuration, the
@@ -203,15 +170,9 @@ pub fn dubins_goal(p: &Problem, plan: &Plan) -> Option<Plan> {
         let best = dubins_finishes(p, ci, &q, &p.goal)
             .into_iter()
             .map(|pushes| {
-                let mut out = plan.clone();
-                out.steps.truncate(back);
-                let changes = out
-                    .steps
-                    .windows(2)
-                    .filter(|w| w[0].contact != w[1].contact)
-                    .count();
-                out.transits.truncate(changes);
-                out.steps.extend(steps_of(p, ci, &q, &pushes, &p.goal));
+                let mut out = backed_up(plan, back);
+                let pushes: Vec<(V3, usize)> = pushes.iter().map(|u| (u.xi, u.control)).collect();
+                out.steps.extend(push_steps(p, ci, &q, &pushes, &p.goal));
                 summarise(p, &mut out);
                 out.exact_goal = true;
                 out

@@ -1055,52 +1055,73 @@ pub fn exact_goal(p: &Problem, plan: &Plan) -> Option<Plan> {
             if change && p.params.c.is_none() {
                 continue;
             }
-            let mut out = plan.clone();
-            out.steps.truncate(back);
-            out.transits.clear();
-            let mut transits_needed = vec![];
-            let mut prev_c: Option<usize> = None;
-            for s in &out.steps {
-                if prev_c.is_some_and(|c| c != s.contact) {
-                    transits_needed.push(s.from);
-                }
-                prev_c = Some(s.contact);
-            }
-            out.transits = plan.transits[..transits_needed.len().min(plan.transits.len())].to_vec();
+            let mut out = backed_up(plan, back);
             if change && p.pusher.is_mobile() {
                 match transit(p, &q, last_contact.unwrap_or(ci), ci, 0) {
                     Some(t) => out.transits.push(t),
                     None => continue,
                 }
             }
-            // Length of the push in step units.
-            let unit = super::step_twist(&p.slider, &xi, p.params.step);
-            let n_steps = (xi.norm() / unit.norm()).ceil().max(1.0) as usize;
-            for k in 0..n_steps {
-                let a = xi * (k as f64 / n_steps as f64);
-                let b = xi * ((k + 1) as f64 / n_steps as f64);
-                let from = q.integrate(&a);
-                let to = if k + 1 == n_steps {
-                    p.goal
-                } else {
-                    q.integrate(&b)
-                };
-                let tw = xi / n_steps as f64;
-                out.steps.push(super::search::Step {
-                    contact: ci,
-                    edge: cm.edge,
-                    control: usize::MAX,
-                    from,
-                    to,
-                    twist: [tw.x, tw.y, tw.z],
-                });
-            }
+            out.steps
+                .extend(push_steps(p, ci, &q, &[(xi, usize::MAX)], &p.goal));
             summarise(p, &mut out);
             out.exact_goal = true;
             return Some(out);
         }
     }
     None
+}
+
+/// `plan` backed up to its first `back` steps, with the transit paths of the contact changes
+/// among them: where the exact-goal finishes of §4.5 continue from.
+pub(super) fn backed_up(plan: &Plan, back: usize) -> Plan {
+    let mut out = plan.clone();
+    out.steps.truncate(back);
+    let changes = out
+        .steps
+        .windows(2)
+        .filter(|w| w[0].contact != w[1].contact)
+        .count();
+    out.transits.truncate(changes);
+    out
+}
+
+/// The steps of the constant pushes `pushes` (whole slider-frame twists, each with its control
+/// index) with contact `ci` from `q`, each push cut into steps of the problem's step length (so
+/// the cost counts them as the search counts steps); the last step ends on `goal` exactly.
+pub(super) fn push_steps(
+    p: &Problem,
+    ci: usize,
+    q: &Pose,
+    pushes: &[(V3, usize)],
+    goal: &Pose,
+) -> Vec<Step> {
+    let edge = p.contacts[ci].edge;
+    let mut out = Vec::new();
+    let mut at = *q;
+    for (j, &(xi, control)) in pushes.iter().enumerate() {
+        let unit = super::step_twist(&p.slider, &xi, p.params.step);
+        let n = (xi.norm() / unit.norm()).ceil().max(1.0) as usize;
+        let tw = xi / n as f64;
+        for k in 0..n {
+            let from = at.integrate(&(xi * (k as f64 / n as f64)));
+            let to = if j + 1 == pushes.len() && k + 1 == n {
+                *goal
+            } else {
+                at.integrate(&(xi * ((k + 1) as f64 / n as f64)))
+            };
+            out.push(Step {
+                contact: ci,
+                edge,
+                control,
+                from,
+                to,
+                twist: [tw.x, tw.y, tw.z],
+            });
+        }
+        at = at.integrate(&xi);
+    }
+    out
 }
 
 /// Brute-force uniform-cost search over the same step discretisation *without grid pruning*,
