@@ -1,6 +1,7 @@
 //! Vision against the simulated camera's ground truth: detection, calibration and pose accuracy
 //! on a few hundred rendered 960×720 frames with noise and mild blur; frame sources; CLI.
 
+use pushbot::sim::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
 use pushbot::vision::apriltag::{AprilTagC, AprilTagCConfig};
 use pushbot::vision::detect::{Detector, Region};
 use pushbot::vision::folder::FolderSource;
@@ -9,7 +10,6 @@ use pushbot::vision::kornia::{KorniaConfig, KorniaDetector};
 use pushbot::vision::layout::MarkerLayout;
 use pushbot::vision::simsocket::SimSocketSource;
 use pushbot::vision::source::{FrameSource, SourceError, open_source};
-use pushbot::vision::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
 use pushbot::vision::tracking::TrackerParams;
 use pushbot::vision::{Pipeline, RoiParams, measure};
 use pushbot_sim::camera::CameraFrame;

@@ -11,16 +11,15 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub use pushbot_world::{geometry, presets, scene};
+
 pub mod encoder;
 pub mod faults;
-pub mod geometry;
 pub mod motor;
-pub mod presets;
 pub mod pty;
 pub mod pushing;
 pub mod quasistatic;
 pub mod robot;
-pub mod scene;
 pub mod sim;
 pub mod world;
 

@@ -5,35 +5,9 @@
 //! y along the height, angles counter-clockwise from +x. The robot's pose is the centre of its
 //! wheel axle (which is also the bumper's centre) and its heading.
 
-use std::f64::consts::PI;
-
 use rand::Rng;
-use serde::{Deserialize, Serialize};
 
-/// A pose in the table frame: metres and radians.
-#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Pose {
-    /// x, m.
-    pub x: f64,
-    /// y, m.
-    pub y: f64,
-    /// Heading, rad, counter-clockwise from +x.
-    pub theta: f64,
-}
-
-impl Pose {
-    /// A pose.
-    pub const fn new(x: f64, y: f64, theta: f64) -> Self {
-        Pose { x, y, theta }
-    }
-}
-
-/// Wrap an angle to (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
-    let w = a.rem_euclid(2.0 * PI);
-    if w > PI { w - 2.0 * PI } else { w }
-}
+pub use pushbot_world::pose::{Pose, wrap_angle};
 
 /// Body twist from wheel rim speeds (m/s) `[left, right]`: (forward speed m/s, turn rate rad/s).
 pub fn twist_from_wheels(rim: [f64; 2], wheel_base: f64) -> (f64, f64) {
@@ -59,15 +33,7 @@ pub fn arc_displacement(theta: f64, v: f64, omega: f64, dt: f64) -> (f64, f64, f
     (chord * mid.cos(), chord * mid.sin(), dth)
 }
 
-/// Bumper switch bits, as the firmware reads them.
-pub mod switch {
-    /// Left switch.
-    pub const LEFT: u8 = 1 << 0;
-    /// Centre switch.
-    pub const CENTRE: u8 = 1 << 1;
-    /// Right switch.
-    pub const RIGHT: u8 = 1 << 2;
-}
+pub use pushbot_world::body::switch;
 
 /// Which switches a press at `angle` (rad, relative to the heading, counter-clockwise, so
 /// positive is the robot's left) closes. The bumper covers the front half: the centre switch
@@ -135,6 +101,7 @@ impl BumperSwitches {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     /// Kinematics round-trip, and the arc displacement of a full circle closes.
     #[test]

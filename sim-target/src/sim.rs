@@ -20,7 +20,7 @@ use crate::encoder::Encoder;
 use crate::faults::LinkFaults;
 use crate::robot::{BumperSwitches, Pose};
 use crate::scene::Scene;
-use crate::world::{Body, Hardware, World};
+use crate::world::{Hardware, World};
 
 /// Everything that sets up a simulated robot.
 #[derive(Clone, Debug)]
@@ -178,7 +178,7 @@ impl Sim {
             bail!("substeps must be 1..=1000, not {}", opts.substeps);
         }
         let (robot, hardware) = built_for(opts);
-        let body = Body::from_geometry(&robot.geometry);
+        let body = crate::world::body_from_geometry(&robot.geometry);
         // The world's and the sensors' noise come from separate streams of the one seed.
         let world = match &opts.scene {
             Some(scene) => World::from_scene(scene, body, hardware, opts.seed)?,

@@ -18,108 +18,25 @@ use anyhow::{Result, bail};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use serde::{Deserialize, Serialize};
-
 use crate::geometry::{ContactPoint, Outline};
 use crate::motor::{Motor, MotorParams, advance_with_friction};
 use crate::pushing::Slider;
 use crate::quasistatic::{BodyRef, Drive, Mobile, Row, solve};
-use crate::robot::{
-    Pose, arc_displacement, switch, switches_for_angle, twist_from_wheels, wrap_angle,
-};
+use crate::robot::{Pose, arc_displacement, switches_for_angle, twist_from_wheels, wrap_angle};
 use crate::scene::Scene;
 
 /// Standard gravity, m/s².
 const G: f64 = 9.81;
 
-/// The robot's body dimensions, m.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Body {
-    /// Distance between the wheel contact points.
-    pub wheel_base: f64,
-    /// Wheel radius.
-    pub wheel_radius: f64,
-    /// Bumper radius around the axle centre.
-    pub bumper_radius: f64,
-    /// A flat plate across the front, if fitted (default: the round bumper only).
-    pub front_plate: Option<FrontPlate>,
-}
+pub use pushbot_world::body::{Body, FrontPlate};
 
-/// A flat bumper plate across the robot's front: a straight plate `width` m wide,
-/// perpendicular to the heading, its face `offset` m ahead of the wheel axis (centred on the
-/// heading). The robot's outline is the round body plus the plate (a plate
-/// [`FrontPlate::THICKNESS`] thick behind its face). Objects pushed flat against it touch it
-/// along a line (line contact, Lynch & Mason §2). Its switches close by where it is pressed:
-/// the right switch for presses on its right part (from the right end to `width/8` right of
-/// centre), the centre switch within `width/4` of the centre, the left switch on its left part
-/// (the zones overlap, like the round bumper's sectors); a flush press spanning the plate
-/// closes all three.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FrontPlate {
-    /// Plate width, m.
-    pub width: f64,
-    /// Distance of the plate's face ahead of the wheel axis, m.
-    pub offset: f64,
-}
-
-impl FrontPlate {
-    /// Thickness of the plate behind its face, m.
-    pub const THICKNESS: f64 = 0.004;
-
-    /// The plate's outline in the robot frame (x ahead, y to the left).
-    pub fn outline(&self) -> [[f64; 2]; 4] {
-        let (h, f, b) = (self.width / 2.0, self.offset, self.offset - Self::THICKNESS);
-        [[b, -h], [f, -h], [f, h], [b, h]]
-    }
-
-    /// Whether the plate is usable: finite, positive width, face ahead of the axis.
-    pub fn valid(&self) -> bool {
-        self.width.is_finite()
-            && self.offset.is_finite()
-            && self.width > 0.0
-            && self.offset > Self::THICKNESS
-    }
-
-    /// The switches closed by presses spanning lateral positions `lo..=hi` (m, left positive).
-    pub fn switches(&self, lo: f64, hi: f64) -> u8 {
-        let w = self.width;
-        let hit = |a: f64, b: f64| hi >= a && lo <= b;
-        let mut bits = 0;
-        if hit(-w / 4.0, w / 4.0) {
-            bits |= switch::CENTRE;
-        }
-        if hit(w / 8.0, f64::INFINITY) {
-            bits |= switch::LEFT;
-        }
-        if hit(f64::NEG_INFINITY, -w / 8.0) {
-            bits |= switch::RIGHT;
-        }
-        bits
-    }
-}
-
-impl Body {
-    /// The dimensions in a firmware geometry.
-    pub fn from_geometry(g: &pushbot_protocol::Geometry) -> Self {
-        Body {
-            wheel_base: f64::from(g.wheel_base),
-            wheel_radius: f64::from(g.wheel_radius),
-            bumper_radius: f64::from(g.bumper_radius),
-            front_plate: None,
-        }
-    }
-
-    /// The robot's outline (robot frame): the round bumper, plus the plate if fitted.
-    pub fn outline(&self) -> Result<Outline> {
-        let disc = Outline::disc(self.bumper_radius);
-        match self.front_plate {
-            None => Ok(disc),
-            Some(p) if p.valid() => Ok(disc.with_convex_part(&p.outline())?),
-            Some(p) => {
-                bail!("front plate {p:?} needs a positive width and its face ahead of the axle")
-            }
-        }
+/// The robot's body dimensions in a firmware geometry (no front plate).
+pub fn body_from_geometry(g: &pushbot_protocol::Geometry) -> Body {
+    Body {
+        wheel_base: f64::from(g.wheel_base),
+        wheel_radius: f64::from(g.wheel_radius),
+        bumper_radius: f64::from(g.bumper_radius),
+        front_plate: None,
     }
 }
 
@@ -795,5 +712,23 @@ pub fn polygons_overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> bool {
     match (Outline::polygon(a), Outline::polygon(b)) {
         (Ok(a), Ok(b)) => a.overlaps(&Pose::default(), &b, &Pose::default(), 1e-9),
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod reference_robot {
+    /// The scene format's default robot (in `pushbot-world`, which knows neither the firmware
+    /// nor the motor model) is the firmware's reference geometry with the default motor.
+    #[test]
+    fn scene_default_robot_is_the_firmware_and_motor_default() {
+        let spec = crate::scene::RobotSpec::default();
+        let g = pushbot_firmware::RobotParams::default().geometry;
+        let m = crate::motor::MotorParams::default();
+        assert_eq!(spec.bumper_radius, f64::from(g.bumper_radius));
+        assert_eq!(spec.wheel_base, f64::from(g.wheel_base));
+        assert_eq!(spec.wheel_radius, f64::from(g.wheel_radius));
+        assert_eq!(spec.encoder_cpr, g.encoder_cpr);
+        assert_eq!(spec.no_load_speed, m.no_load_speed());
+        assert_eq!(spec.stall_torque, m.stall_torque());
     }
 }

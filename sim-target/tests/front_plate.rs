@@ -26,7 +26,7 @@ fn exact() -> Hardware {
 fn plated() -> Body {
     Body {
         front_plate: Some(PLATE),
-        ..Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry)
+        ..pushbot_sim::world::body_from_geometry(&pushbot_firmware::RobotParams::default().geometry)
     }
 }
 
@@ -94,7 +94,8 @@ fn square_pushed_squarely_by_the_plate_translates_flush() {
         assert!(w.pose().theta.abs() < 1e-7);
     }
     // The same off-centre push with the round bumper turns the box (so the test can fail).
-    let round = Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry);
+    let round =
+        pushbot_sim::world::body_from_geometry(&pushbot_firmware::RobotParams::default().geometry);
     let mut w = World::new((1.2, 0.9), Pose::new(0.2, 0.45, 0.0), round, exact(), 1).unwrap();
     w.add_object("box", box_at(0.31, 0.47, 0.08, 0.5)).unwrap();
     for _ in 0..2500 {
@@ -181,7 +182,7 @@ fn scenes_fit_the_plate() {
     assert_eq!(scene.robot.front_plate, Some(PLATE));
     let w = World::from_scene(
         &scene,
-        Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry),
+        pushbot_sim::world::body_from_geometry(&pushbot_firmware::RobotParams::default().geometry),
         exact(),
         1,
     )
@@ -197,7 +198,9 @@ fn scenes_fit_the_plate() {
     assert!(
         World::from_scene(
             &Scene::from_toml(&off, "x").unwrap_or(scene.clone()),
-            Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry),
+            pushbot_sim::world::body_from_geometry(
+                &pushbot_firmware::RobotParams::default().geometry
+            ),
             exact(),
             1
         )

@@ -24,7 +24,7 @@ fn exact() -> Hardware {
 }
 
 fn body() -> Body {
-    Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry)
+    pushbot_sim::world::body_from_geometry(&pushbot_firmware::RobotParams::default().geometry)
 }
 
 fn slider(outline: Vec<[f64; 2]>, pose: Pose) -> Slider {

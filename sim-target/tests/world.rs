@@ -10,7 +10,7 @@ const DT: f64 = 1e-3;
 const TABLE: (f64, f64) = (1.2, 0.9);
 
 fn body() -> Body {
-    Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry)
+    pushbot_sim::world::body_from_geometry(&pushbot_firmware::RobotParams::default().geometry)
 }
 
 /// The physics without any noise.

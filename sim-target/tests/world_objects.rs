@@ -20,7 +20,7 @@ fn exact() -> Hardware {
 }
 
 fn body() -> Body {
-    Body::from_geometry(&pushbot_firmware::RobotParams::default().geometry)
+    pushbot_sim::world::body_from_geometry(&pushbot_firmware::RobotParams::default().geometry)
 }
 
 fn box_at(x: f64, y: f64, side: f64) -> Slider {

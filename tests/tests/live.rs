@@ -2,7 +2,8 @@
 //! serial link on the sim's pty and the real vision pipeline on the sim's camera socket
 //! ([`pushbot::exec::LiveRobot`]), judged by the simulator's ground truth.
 
-use pushbot::exec::{LiveOptions, LiveRobot, SimTarget};
+use pushbot::exec::{LiveOptions, LiveRobot};
+use pushbot::sim::SimTarget;
 use pushbot::strategy::robot_io::RobotIo;
 use pushbot_sim::Scene;
 use pushbot_tests::{SIM_SPEED, angle_diff};

@@ -3,11 +3,12 @@
 //! observes the boxes through the real vision pipeline on the sim's camera
 //! ([`pushbot::exec::LiveRobot`]); the simulator's ground truth judges where the boxes ended.
 
-use pushbot::exec::{LiveOptions, LiveRobot, SimTarget};
+use pushbot::exec::{LiveOptions, LiveRobot};
 use pushbot::planner::rearrange::execute::{
     ExecOptions, GridFrame, SceneOptions, execute, scene_for,
 };
 use pushbot::planner::rearrange::{Model, cases::load_scene, cost_map};
+use pushbot::sim::SimTarget;
 use pushbot_tests::SIM_SPEED;
 
 #[test]

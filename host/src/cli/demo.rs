@@ -20,12 +20,13 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::record::{Recorder, TracePoint, TruthProbe};
-use crate::exec::{LiveOptions, LiveRobot, SimTarget};
+use crate::exec::{LiveOptions, LiveRobot};
 use crate::report::{Report, StageReport, figure};
+use crate::sim::SimTarget;
 use crate::strategy::sample::Pose2;
 
 /// The stages, in the order they run.
@@ -414,7 +415,7 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
 
 /// Where the object's marker truly is, from its true body pose.
 fn scene_marker_truth(
-    object: &pushbot_sim::scene::Object,
+    object: &pushbot_world::scene::Object,
     truth: &[(String, Pose2)],
 ) -> Option<[f64; 2]> {
     let (_, p) = truth.iter().find(|(id, _)| *id == object.id)?;

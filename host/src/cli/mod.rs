@@ -120,6 +120,16 @@ impl CliError {
     }
 }
 
+/// The error of a command that needs the built-in simulated target in a build without it
+/// (`--no-default-features`): exit 2, naming what to give instead.
+#[cfg(not(feature = "sim"))]
+pub fn no_simulated_target() -> CliError {
+    CliError::bad_input(
+        "this build of pushbot has no simulated target (built without the `sim` feature): \
+         give --port PATH (and --camera SRC) for a real robot",
+    )
+}
+
 /// What every command's `run` returns.
 pub type CliResult = Result<Status, CliError>;
 

@@ -138,7 +138,8 @@ fn faults_json(f: Faults) -> Value {
 
 /// The robot's end: a port given, or the built-in simulated robot.
 struct Target {
-    sim: Option<pushbot_sim::PtySim>,
+    #[cfg(feature = "sim")]
+    sim: Option<crate::sim::SimTarget>,
     path: String,
 }
 
@@ -146,43 +147,48 @@ impl Target {
     fn open(args: &RobotArgs, seed: u64) -> Result<Target, CliError> {
         match &args.port {
             Some(p) => Ok(Target {
+                #[cfg(feature = "sim")]
                 sim: None,
                 path: p.clone(),
             }),
-            None => {
-                if !(args.sim_speed.is_finite() && args.sim_speed > 0.0) {
-                    return Err(CliError::bad_input(format!(
-                        "--sim-speed must be a positive number, got {}",
-                        args.sim_speed
-                    )));
-                }
-                let scene = match &args.scene {
-                    Some(s) => Some(
-                        pushbot_sim::Scene::preset_or_file(s)
-                            .map_err(|e| CliError::bad_input(e.to_string()))?,
-                    ),
-                    None => None,
-                };
-                let sim = pushbot_sim::PtySim::start(pushbot_sim::SimOptions {
-                    seed,
-                    speed: args.sim_speed,
-                    scene,
-                    ..Default::default()
-                })
-                .map_err(|e| {
-                    CliError::Failed(e.context("starting the built-in simulated robot"))
-                })?;
-                let path = sim.serial_path().to_string();
-                tracing::info!("built-in simulated robot on {path}");
-                Ok(Target {
-                    sim: Some(sim),
-                    path,
-                })
-            }
+            None => Self::built_in(args, seed),
         }
     }
 
+    /// The built-in simulated robot on a pty.
+    #[cfg(feature = "sim")]
+    fn built_in(args: &RobotArgs, seed: u64) -> Result<Target, CliError> {
+        if !(args.sim_speed.is_finite() && args.sim_speed > 0.0) {
+            return Err(CliError::bad_input(format!(
+                "--sim-speed must be a positive number, got {}",
+                args.sim_speed
+            )));
+        }
+        let scene = match &args.scene {
+            Some(s) => Some(
+                pushbot_world::Scene::preset_or_file(s)
+                    .map_err(|e| CliError::bad_input(e.to_string()))?,
+            ),
+            None => None,
+        };
+        let sim = crate::sim::SimTarget::start_robot(scene.as_ref(), seed, args.sim_speed)
+            .map_err(CliError::Failed)?;
+        let path = sim.port().to_string();
+        tracing::info!("built-in simulated robot on {path}");
+        Ok(Target {
+            sim: Some(sim),
+            path,
+        })
+    }
+
+    /// Without the `sim` feature there is no built-in robot: `--port` is needed.
+    #[cfg(not(feature = "sim"))]
+    fn built_in(_args: &RobotArgs, _seed: u64) -> Result<Target, CliError> {
+        Err(crate::cli::no_simulated_target())
+    }
+
     fn close(self) {
+        #[cfg(feature = "sim")]
         if let Some(sim) = self.sim
             && let Err(e) = sim.shutdown()
         {

@@ -28,7 +28,7 @@ pub struct CheckArgs {
 pub fn run(g: &Global, cmd: SceneCommand) -> CliResult {
     match cmd {
         SceneCommand::Check(a) => {
-            let s = pushbot_sim::Scene::preset_or_file(&a.scene)
+            let s = pushbot_world::Scene::preset_or_file(&a.scene)
                 .map_err(|e| CliError::bad_input(e.to_string()))?;
             let ids: Vec<&str> = s.objects.iter().map(|o| o.id.as_str()).collect();
             if g.json {
@@ -54,7 +54,7 @@ pub fn run(g: &Global, cmd: SceneCommand) -> CliResult {
             Ok(Status::Success)
         }
         SceneCommand::List => {
-            let shared = pushbot_sim::scene::PRESETS;
+            let shared = pushbot_world::scene::PRESETS;
             let rearrange: Vec<&str> = crate::planner::rearrange::cases::CASES
                 .iter()
                 .map(|c| c.0)

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};

@@ -83,7 +83,7 @@ pub enum BenchCommand {
 
 fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
     if let Some(scene) = &args.scene {
-        let scene = pushbot_sim::Scene::preset_or_file(scene)
+        let scene = pushbot_world::Scene::preset_or_file(scene)
             .map_err(|e| CliError::bad_input(e.to_string()))?;
         return Ok(MarkerLayout::from_scene(&scene));
     }

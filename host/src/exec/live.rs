@@ -14,7 +14,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, anyhow, bail};
 use nalgebra::Vector2;
 use pushbot_protocol::Outcome;
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 
 use super::grabber::FrameGrabber;
 use crate::link::{LinkOptions, Robot};

@@ -4,13 +4,11 @@
 //! [`live::LiveRobot`] is the [`RobotIo`](crate::strategy::robot_io::RobotIo) every planner and
 //! the learned strategy drive, implemented over a real serial link ([`crate::link`]) and a real
 //! camera ([`crate::vision`]): the same code runs a robot on a table and the simulated target
-//! (`pushbot-sim`, or [`target::SimTarget`] in process), which it cannot tell apart.
+//! (`pushbot-sim`, or the built-in target `crate::sim::SimTarget`), which it cannot tell apart.
 
 pub mod grabber;
 pub mod live;
 pub mod record;
-pub mod target;
 pub mod view;
 
 pub use live::{LiveOptions, LiveRobot};
-pub use target::SimTarget;

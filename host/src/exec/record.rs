@@ -154,7 +154,7 @@ mod tests {
 
     #[test]
     fn records_a_point_after_every_primitive() {
-        let scene = pushbot_sim::Scene::preset("lau-irregular").expect("preset");
+        let scene = pushbot_world::Scene::preset("lau-irregular").expect("preset");
         let mut robot = SimRobot::new(scene, None, None, SimRobotOptions::default()).expect("sim");
         let ids = vec!["object".to_string()];
         let mut rec = Recorder::new(&mut robot, &ids, None);

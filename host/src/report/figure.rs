@@ -5,8 +5,8 @@
 
 use std::fmt::Write;
 
-use pushbot_sim::Scene;
-use pushbot_sim::scene::placed;
+use pushbot_world::Scene;
+use pushbot_world::scene::placed;
 
 use crate::exec::record::TracePoint;
 use crate::strategy::sample::Pose2;
@@ -25,7 +25,7 @@ fn outline_at(scene: &Scene, id: &str, pose: &Pose2) -> Option<Vec<[f64; 2]>> {
     let o = scene.object(id)?;
     Some(placed(
         &o.outline,
-        &pushbot_sim::Pose::new(pose.x, pose.y, pose.theta),
+        &pushbot_world::Pose::new(pose.x, pose.y, pose.theta),
     ))
 }
 

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{Result, anyhow};
 use nalgebra::Vector2;
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 
 use super::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use super::obstacles::{ObstacleParams, deliver_among_obstacles, scene_obstacles};

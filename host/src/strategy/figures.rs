@@ -6,7 +6,7 @@
 use std::fmt::Write;
 
 use nalgebra::Vector2;
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 
 use super::sample::{Pose2, Sample};
 

@@ -21,7 +21,7 @@ use anyhow::{Result, anyhow};
 use indicatif::ProgressBar;
 use nalgebra::Vector2;
 use pathfinding::prelude::astar;
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 
 use super::collect::{CollectParams, CollectReport, collect};
 use super::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};

@@ -3,7 +3,7 @@
 //! in `.cargo/config.toml`), so results do not depend on what the machine has installed.
 
 use apriltag::{Detector as CDetector, DetectorBuilder, Family, Image};
-use pushbot_sim::camera::MarkerFamily;
+use pushbot_world::camera::MarkerFamily;
 
 use super::detect::{DetectError, Detection, Detector, Region, check};
 use super::source::Frame;

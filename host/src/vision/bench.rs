@@ -20,9 +20,9 @@ use super::detect::Detector;
 #[cfg(feature = "kornia")]
 use super::kornia::{KorniaConfig, KorniaDetector};
 use super::layout::MarkerLayout;
-use super::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
 use super::tracking::TrackerParams;
 use super::{Pipeline, RoiParams};
+use crate::sim::synth::{self, DetectionScore, PoseScore, SynthParams, quantile};
 
 /// This process's CPU time, milliseconds: every thread's, so a detector that works on a
 /// one-thread pool (kornia) is counted while the caller waits.

@@ -5,7 +5,7 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use pushbot_sim::camera::Homography;
+use pushbot_world::camera::Homography;
 use serde::{Deserialize, Serialize};
 
 use super::detect::Detection;
@@ -184,7 +184,7 @@ impl Calibration {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pushbot_sim::camera::{CameraModel, MarkerFamily};
+    use pushbot_world::camera::{CameraModel, MarkerFamily};
 
     fn det(id: u32, corners: [[f64; 2]; 4], centre: [f64; 2]) -> Detection {
         Detection {
@@ -225,7 +225,7 @@ mod tests {
             assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6);
         }
         assert!((cal.mm_per_px - 1.31).abs() < 0.05, "{}", cal.mm_per_px);
-        let body = pushbot_sim::camera::MarkerPlacement {
+        let body = pushbot_world::camera::MarkerPlacement {
             id: 10,
             family: MarkerFamily::Tag36h11,
             centre: [0.4, 0.3],

@@ -1,7 +1,7 @@
 //! Marker detection behind one trait, so the pipeline does not depend on which library finds
 //! the tags.
 
-use pushbot_sim::camera::MarkerFamily;
+use pushbot_world::camera::MarkerFamily;
 
 use super::source::Frame;
 

@@ -3,7 +3,7 @@
 //! destination plane.
 
 use nalgebra::{DMatrix, Matrix3, SMatrix, SVector};
-use pushbot_sim::camera::Homography;
+use pushbot_world::camera::Homography;
 
 /// Why no homography could be fitted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -6,7 +6,7 @@
 use kornia_apriltag::family::TagFamilyKind;
 use kornia_apriltag::{AprilTagDecoder, DecodeTagsConfig};
 use kornia_image::{Image, ImageSize};
-use pushbot_sim::camera::MarkerFamily;
+use pushbot_world::camera::MarkerFamily;
 
 use super::detect::{DetectError, Detection, Detector, Region, check};
 use super::source::Frame;

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use pushbot_sim::camera::{MarkerFamily, MarkerPlacement};
+use pushbot_world::camera::{MarkerFamily, MarkerPlacement};
 use serde::{Deserialize, Serialize};
 
 /// A planar pose on the table: metres and radians (CCW from the table's +x).
@@ -183,8 +183,8 @@ impl MarkerLayout {
     /// The layout a scene describes: its table, its calibration markers (`[camera] fiducials`),
     /// the robot's marker (body `robot`), each object's marker (body = the object's id) and each
     /// goal's marker (body `goal:<object id>`).
-    pub fn from_scene(scene: &pushbot_sim::Scene) -> MarkerLayout {
-        let body = |name: String, m: &pushbot_sim::scene::Marker| BodyMarker {
+    pub fn from_scene(scene: &pushbot_world::Scene) -> MarkerLayout {
+        let body = |name: String, m: &pushbot_world::scene::Marker| BodyMarker {
             body: name,
             id: m.id,
             family: MarkerFamily::Tag36h11,

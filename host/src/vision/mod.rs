@@ -29,7 +29,6 @@ pub mod kornia;
 pub mod layout;
 pub mod simsocket;
 pub mod source;
-pub mod synth;
 pub mod tracking;
 pub mod v4l2;
 

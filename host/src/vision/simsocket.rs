@@ -1,10 +1,10 @@
 //! The sim camera's socket as a frame source: the protocol of
-//! `pushbot_sim::camera::server` (a JSON header line, then `width × height` gray bytes).
+//! `pushbot_world::camera::server` (a JSON header line, then `width × height` gray bytes).
 
 use std::io::{BufRead, BufReader, Read};
 use std::net::TcpStream;
 
-use pushbot_sim::camera::server::FrameHeader;
+use pushbot_world::camera::FrameHeader;
 
 use super::source::{Frame, FrameSource, SourceError};
 
@@ -17,7 +17,7 @@ pub struct SimSocketSource {
     addr: String,
     reader: BufReader<TcpStream>,
     /// The ground truth sent with the last frame, if any.
-    pub last_truth: Vec<pushbot_sim::camera::MarkerTruth>,
+    pub last_truth: Vec<pushbot_world::camera::MarkerTruth>,
 }
 
 impl SimSocketSource {

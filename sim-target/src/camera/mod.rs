@@ -22,48 +22,7 @@ use serde::{Deserialize, Serialize};
 pub use render::{Homography, MarkerFamily, MarkerPlacement, Polygon, TagCodes};
 pub use scene_view::{SceneCamera, scene_view};
 
-/// Where the camera looks: image size and the table-plane → pixel homography.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct CameraModel {
-    /// Image width, pixels.
-    pub width: u32,
-    /// Image height, pixels.
-    pub height: u32,
-    /// Table metres → pixel coordinates (pixel centres at `i + 0.5`).
-    pub table_to_pixel: Homography,
-}
-
-impl CameraModel {
-    /// A camera straight above the centre of a `table[0] × table[1]` m table, the table filling
-    /// the image but for `margin_px` on its tighter side; table +y is image up.
-    pub fn overhead(table: [f64; 2], width: u32, height: u32, margin_px: f64) -> CameraModel {
-        let s = ((width as f64 - 2.0 * margin_px) / table[0])
-            .min((height as f64 - 2.0 * margin_px) / table[1]);
-        let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
-        CameraModel {
-            width,
-            height,
-            table_to_pixel: Homography([
-                [s, 0.0, cx - s * table[0] / 2.0],
-                [0.0, -s, cy + s * table[1] / 2.0],
-                [0.0, 0.0, 1.0],
-            ]),
-        }
-    }
-
-    /// The same camera slightly tilted: a perspective term `(px, py)` per pixel about the image
-    /// centre (1e-5 is a mild tilt).
-    pub fn tilted(self, px: f64, py: f64) -> CameraModel {
-        let (cx, cy) = (self.width as f64 / 2.0, self.height as f64 / 2.0);
-        let t = Homography([[1.0, 0.0, cx], [0.0, 1.0, cy], [0.0, 0.0, 1.0]]);
-        let t_inv = Homography([[1.0, 0.0, -cx], [0.0, 1.0, -cy], [0.0, 0.0, 1.0]]);
-        let p = Homography([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [px, py, 1.0]]);
-        CameraModel {
-            table_to_pixel: t.compose(&p).compose(&t_inv).compose(&self.table_to_pixel),
-            ..self
-        }
-    }
-}
+pub use pushbot_world::camera::{CameraModel, MarkerTruth};
 
 /// Optics and sensor of the simulated camera.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -130,20 +89,6 @@ impl CameraConfig {
             table,
         }
     }
-}
-
-/// Ground truth of one marker in one frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MarkerTruth {
-    /// The placement drawn.
-    pub marker: MarkerPlacement,
-    /// Corners of the black square in pixels: printed bottom-left, bottom-right, top-right,
-    /// top-left.
-    pub corners_px: [[f64; 2]; 4],
-    /// Centre in pixels.
-    pub centre_px: [f64; 2],
-    /// Whether the whole marker, quiet zone included, lies inside the image.
-    pub fully_visible: bool,
 }
 
 /// One frame: 8-bit grayscale pixels row-major plus ground truth.

@@ -19,23 +19,7 @@ use std::time::Duration;
 
 use super::CameraFrame;
 
-/// The header line sent before each frame's pixels.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-pub struct FrameHeader {
-    /// Frame number.
-    pub seq: u64,
-    /// Simulated time of exposure, seconds.
-    pub time: f64,
-    /// Width, pixels.
-    pub width: u32,
-    /// Height, pixels.
-    pub height: u32,
-    /// Pixel format: always `"gray8"`.
-    pub format: String,
-    /// Ground truth of the markers drawn.
-    #[serde(default)]
-    pub truth: Vec<super::MarkerTruth>,
-}
+pub use pushbot_world::camera::FrameHeader;
 
 /// A frame server on a local socket; clients are accepted on a background thread.
 #[derive(Debug)]

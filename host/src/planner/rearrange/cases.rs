@@ -1,10 +1,10 @@
 //! The test cases of Ben-Shahar & Rivlin §V-A (A1–A4, B1–B2, C1–C2, D1) and how the grid
-//! planner reads a scene: every scene is one of the shared format (`pushbot_sim::Scene`) with a
+//! planner reads a scene: every scene is one of the shared format (`pushbot_world::Scene`) with a
 //! `[rearrange]` section, rasterised by [`super::scene::problem_from_scene`]. The cases are the
 //! simulator's presets `bsr-a1` … `bsr-d1` (`sim-target/src/presets/bsr-*.toml`); their paper
 //! names `A1` … `D1` are accepted as aliases.
 
-use pushbot_sim::Scene;
+use pushbot_world::Scene;
 
 use super::problem::Problem;
 
@@ -57,7 +57,7 @@ pub fn preset_name(name: &str) -> Option<&'static str> {
         .find(|(n, _, _)| n.eq_ignore_ascii_case(name))
         .map(|c| c.1)
         .or_else(|| {
-            pushbot_sim::scene::PRESETS
+            pushbot_world::scene::PRESETS
                 .iter()
                 .find(|p| **p == name)
                 .copied()

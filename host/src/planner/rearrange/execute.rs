@@ -126,8 +126,8 @@ fn rect_outline(cells: &[(i32, i32)], cell: f64, margin: f64) -> Option<Vec<[f64
 /// obstacles (merged along rows), rectangular movables are boxes at their start with their
 /// goals, the robot starts at the centre of its block facing its start heading. Only
 /// rectangular movables can be built.
-pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::Scene> {
-    use pushbot_sim::scene::{Goal, Marker, Object, Obstacle, RobotSpec, Support, Table};
+pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_world::Scene> {
+    use pushbot_world::scene::{Goal, Marker, Object, Obstacle, RobotSpec, Support, Table};
     let c = opts.cell;
     if !(c.is_finite() && c > 0.0 && opts.fill > 0.0 && opts.fill <= 1.0) {
         bail!("cell must be positive and fill in (0, 1]");
@@ -170,7 +170,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::
         objects.push(Object {
             id: m.name.clone(),
             outline,
-            pose: pushbot_sim::Pose::new(pose.x, pose.y, pose.theta),
+            pose: pushbot_world::Pose::new(pose.x, pose.y, pose.theta),
             mass: opts.kg_per_mass * m.mass.max(1) as f64,
             support: Support::Uniform,
             support_friction: opts.support_friction,
@@ -186,7 +186,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::
             let gpose = frame.body_pose(gp);
             goals.push(Goal {
                 object: m.name.clone(),
-                pose: pushbot_sim::Pose::new(gpose.x, gpose.y, gpose.theta),
+                pose: pushbot_world::Pose::new(gpose.x, gpose.y, gpose.theta),
                 tolerance: 0.25 * c,
                 angle_tolerance: None,
                 marker: None,
@@ -194,21 +194,21 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::
         }
     }
     let rc = frame.robot_centre(problem.start.robot, problem.robot.size);
-    let scene = pushbot_sim::Scene {
+    let scene = pushbot_world::Scene {
         name: problem.name.clone(),
         table: Table {
             width: g.w as f64 * c,
             height: g.h as f64 * c,
         },
         robot: RobotSpec {
-            start: pushbot_sim::Pose::new(rc.x, rc.y, GridFrame::heading(problem.start.heading)),
+            start: pushbot_world::Pose::new(rc.x, rc.y, GridFrame::heading(problem.start.heading)),
             ..robot
         },
         obstacles,
         objects,
         goals,
         positions: Vec::new(),
-        camera: pushbot_sim::scene::CameraSpec::default(),
+        camera: pushbot_world::scene::CameraSpec::default(),
         rearrange: Some(super::scene::rearrange_section(
             problem,
             c,
@@ -217,7 +217,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_sim::
         stable: None,
     };
     // Round-trip through the checked loader so the scene is one the simulator accepts.
-    pushbot_sim::Scene::from_toml(&scene.to_toml(), &format!("grid scene {}", problem.name))
+    pushbot_world::Scene::from_toml(&scene.to_toml(), &format!("grid scene {}", problem.name))
         .map_err(|e| anyhow!("{e}"))
 }
 

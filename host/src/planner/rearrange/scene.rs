@@ -1,6 +1,6 @@
-//! The shared scene format (`pushbot_sim::Scene`) as a grid pushing problem of Ben-Shahar &
+//! The shared scene format (`pushbot_world::Scene`) as a grid pushing problem of Ben-Shahar &
 //! Rivlin §II-A: the table, obstacles, objects and goals rasterised to cells of the scene's
-//! `[rearrange]` section (`pushbot_sim::scene::rearrange`), with its admissibility (§IV-B) and
+//! `[rearrange]` section (`pushbot_world::scene::rearrange`), with its admissibility (§IV-B) and
 //! metric (§IV-C).
 //!
 //! Rasterisation, in the terms of [`GridFrame`] (row 0 along the far edge of the table):
@@ -15,9 +15,9 @@
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::Vector2;
-use pushbot_sim::Scene;
-use pushbot_sim::scene::rearrange::{Field, Rearrange, error_at};
-use pushbot_sim::scene::{SceneError, placed};
+use pushbot_world::Scene;
+use pushbot_world::scene::rearrange::{Field, Rearrange, error_at};
+use pushbot_world::scene::{SceneError, placed};
 
 use super::execute::GridFrame;
 use super::metric::Metric;
@@ -170,7 +170,7 @@ pub fn problem_from_scene(
         // The shape: cells whose centres the outline covers, around the frame's origin; a 3-DOF
         // movable's in its own frame (orientation 0), a 2-DOF one's as it lies on the table.
         let turn = if rotates { 0.0 } else { ob.pose.theta };
-        let outline = placed(&ob.outline, &pushbot_sim::Pose::new(0.0, 0.0, turn));
+        let outline = placed(&ob.outline, &pushbot_world::Pose::new(0.0, 0.0, turn));
         let mut cells = Vec::new();
         for dy in -16..=16 {
             for dx in -16..=16 {
@@ -309,7 +309,7 @@ pub fn problem_from_scene(
 /// The `[rearrange]` section that describes a grid problem's settings (rules, metric, masses,
 /// contact modes and the cells a polygon cannot say: rough and no-leave cells).
 pub fn rearrange_section(p: &Problem, cell: f64, kg_per_mass: f64) -> Rearrange {
-    use pushbot_sim::scene::rearrange::{Metric as M, Movable, Push, Rotate, Rules as R};
+    use pushbot_world::scene::rearrange::{Metric as M, Movable, Push, Rotate, Rules as R};
     let special = p.grid.cells.iter().any(|c| c.rough > 0 || c.no_leave);
     let map = special.then(|| {
         let mut s = String::new();

@@ -106,7 +106,7 @@ pub fn sim_scene(
     p: &Problem,
     start: [f64; 3],
     marker_id: u32,
-) -> Result<pushbot_sim::Scene> {
+) -> Result<pushbot_world::Scene> {
     let mut t = format!(
         "name = \"{}\"\n[table]\nwidth = {}\nheight = {}\n[robot]\nstart = {{ x = {}, y = {}, theta = {} }}\nfront_plate = {{ width = {PLATE_WIDTH}, offset = {PLATE_OFFSET} }}\n",
         s.name, s.table[0], s.table[1], start[0], start[1], start[2]
@@ -128,7 +128,7 @@ pub fn sim_scene(
         "[[goals]]\nobject = \"slider\"\npose = {{ x = {}, y = {}, theta = {} }}\ntolerance = {}\n",
         p.goal.x, p.goal.y, p.goal.theta, p.params.goal_xy
     );
-    pushbot_sim::Scene::from_toml(&t, &format!("stable scene {}", s.name))
+    pushbot_world::Scene::from_toml(&t, &format!("stable scene {}", s.name))
         .map_err(|e| anyhow!("{e}"))
 }
 

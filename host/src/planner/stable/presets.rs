@@ -4,8 +4,8 @@
 //! regions as in the paper (±25 % / ±10 % of the slider length, ±2°). The slider is shaped after
 //! Fig. 12: a box with one corner cut, pushed on two opposite edges.
 //!
-//! Every scene is one of the shared format (`pushbot_sim::Scene`, issue 4) with a `[stable]`
-//! section (`pushbot_sim::scene::stable`), read through [`from_shared`] into the planner's own
+//! Every scene is one of the shared format (`pushbot_world::Scene`, issue 4) with a `[stable]`
+//! section (`pushbot_world::scene::stable`), read through [`from_shared`] into the planner's own
 //! description ([`Scene`]): the presets, and scene files (which need a `[table]`).
 
 use anyhow::{Context, anyhow, bail};
@@ -162,14 +162,14 @@ pub fn scene_from_toml(text: &str, file: &str) -> anyhow::Result<Scene> {
              Scenes section)"
         );
     }
-    let shared = pushbot_sim::Scene::from_toml(text, file).map_err(|e| anyhow!("{e}"))?;
+    let shared = pushbot_world::Scene::from_toml(text, file).map_err(|e| anyhow!("{e}"))?;
     from_shared(&shared).with_context(|| format!("scene file {file}"))
 }
 
 /// Load a scene by preset name or from a file in the shared scene format.
 pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
     if PRESETS.contains(&name_or_path) {
-        let shared = pushbot_sim::Scene::preset(name_or_path).map_err(|e| anyhow!("{e}"))?;
+        let shared = pushbot_world::Scene::preset(name_or_path).map_err(|e| anyhow!("{e}"))?;
         return from_shared(&shared).with_context(|| format!("preset {name_or_path}"));
     }
     let text = std::fs::read_to_string(name_or_path).with_context(|| {
@@ -181,15 +181,15 @@ pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
     scene_from_toml(&text, name_or_path)
 }
 
-/// A stable-pushing scene from a scene in the shared format (`pushbot_sim::Scene`) with a
+/// A stable-pushing scene from a scene in the shared format (`pushbot_world::Scene`) with a
 /// `[stable]` section: the table, the obstacles (as their convex hulls), the pushed object
 /// (its centre of friction from its support distribution, its start from its pose, its goal
 /// from the scene's goal for it, `μ` from its `pusher_friction`), the other objects as static
 /// obstacles, and the pusher and planner settings of `[stable]`; a differential drive takes
 /// its plate from the robot's `front_plate`.
-pub fn from_shared(sc: &pushbot_sim::Scene) -> anyhow::Result<Scene> {
-    use pushbot_sim::scene::Support;
-    use pushbot_sim::scene::stable::StableCost;
+pub fn from_shared(sc: &pushbot_world::Scene) -> anyhow::Result<Scene> {
+    use pushbot_world::scene::Support;
+    use pushbot_world::scene::stable::StableCost;
     let st = sc
         .stable
         .as_ref()
@@ -218,7 +218,7 @@ pub fn from_shared(sc: &pushbot_sim::Scene) -> anyhow::Result<Scene> {
         }
     };
     // The centre of friction's pose on the table, θ in degrees, from the object frame's pose.
-    let cof_pose = |p: &pushbot_sim::Pose| {
+    let cof_pose = |p: &pushbot_world::Pose| {
         let q = Pose::new(p.x, p.y, p.theta).apply(cof);
         [q.x, q.y, p.theta.to_degrees()]
     };

@@ -29,7 +29,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{SceneError, Seg, line_col, span_of};
+use super::SceneError;
+use super::error::{Seg, line_col, path_string, span_of};
 
 /// Grid planning settings of a scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -200,7 +201,7 @@ pub fn error_at(text: Option<&str>, file: &str, path: &[Field], message: String)
         file: file.to_owned(),
         line,
         column,
-        field: Some(super::path_string(&segs)),
+        field: Some(path_string(&segs)),
         message,
     }
 }

@@ -3,10 +3,11 @@
 //! an obstacle or another object. Shapes and overlaps come from parry2d ([`crate::geometry`]);
 //! touching is allowed, overlapping by more than 1 nm is not.
 
-use super::{Invalid, Scene, Seg, invalid};
+use super::Scene;
+use super::error::{Invalid, Seg, invalid};
+use crate::body::Body;
 use crate::geometry::Outline;
-use crate::robot::Pose;
-use crate::world::Body;
+use crate::pose::Pose;
 
 /// Overlaps deeper than this (m) are refused; touching is fine.
 const TOUCH: f64 = 1e-9;
@@ -25,7 +26,7 @@ impl Scene {
                 format!(
                     "needs a positive width and its face ahead of the axle by more than its \
                      thickness ({} m)",
-                    crate::world::FrontPlate::THICKNESS
+                    crate::body::FrontPlate::THICKNESS
                 ),
             ));
         }

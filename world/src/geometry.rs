@@ -10,7 +10,7 @@ use parry2d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQuer
 use parry2d_f64::shape::{Ball, ConvexPolygon, HalfSpace, Shape, ShapeType, SharedShape, TriMesh};
 use parry2d_f64::transformation::hertel_mehlhorn;
 
-use crate::robot::Pose;
+use crate::pose::Pose;
 
 /// A rigid outline made of convex parts, in its own frame.
 #[derive(Clone)]
@@ -73,6 +73,9 @@ pub enum ShapeError {
     /// The triangulation failed.
     #[error("the polygon could not be split into convex parts")]
     Decomposition,
+    /// A front plate that is not usable.
+    #[error("the front plate needs a positive width and its face ahead of the axle")]
+    Plate,
 }
 
 /// Signed area (shoelace), positive for counter-clockwise vertices.

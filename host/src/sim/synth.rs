@@ -6,10 +6,10 @@ use pushbot_sim::camera::{Camera, CameraConfig, CameraModel, Imaging, MarkerTrut
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::calibration::Calibration;
-use super::detect::Detection;
-use super::layout::{MarkerLayout, Pose, wrap_angle};
-use super::source::Frame;
+use crate::vision::calibration::Calibration;
+use crate::vision::detect::Detection;
+use crate::vision::layout::{MarkerLayout, Pose, wrap_angle};
+use crate::vision::source::Frame;
 
 /// A rendered frame with the truth of what is in it.
 #[derive(Debug, Clone)]
@@ -307,7 +307,7 @@ pub struct PoseScore {
 
 impl PoseScore {
     /// Add one frame's measurements.
-    pub fn add(&mut self, measured: &[super::Measurement], truth: &[(String, Pose)]) {
+    pub fn add(&mut self, measured: &[crate::vision::Measurement], truth: &[(String, Pose)]) {
         for (name, pose) in truth {
             match measured.iter().find(|m| &m.body == name) {
                 Some(m) => {

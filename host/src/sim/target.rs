@@ -1,15 +1,17 @@
 //! The built-in simulated target: the simulated robot (running the firmware's own code) served
-//! on a real pseudo-terminal, with its overhead camera on a local socket — what `pushbot demo`
-//! and the hardware-in-the-loop tests connect to exactly as to a robot and a camera.
+//! on a real pseudo-terminal, with its overhead camera on a local socket — what `pushbot demo`,
+//! `pushbot robot` without `--port` and the hardware-in-the-loop tests connect to exactly as to
+//! a robot and a camera.
 
 use anyhow::{Context, Result};
 use pushbot_sim::camera::live::LiveCameraOptions;
-use pushbot_sim::{PtySim, Scene, SimOptions};
+use pushbot_sim::{PtySim, SimOptions};
+use pushbot_world::Scene;
 
 /// A simulated robot and camera serving one scene.
 pub struct SimTarget {
     sim: PtySim,
-    camera: String,
+    camera: Option<String>,
 }
 
 impl std::fmt::Debug for SimTarget {
@@ -42,10 +44,23 @@ impl SimTarget {
         })
         .context("starting the built-in simulated target")?;
         let camera = match sim.camera_addr() {
-            Some(a) => format!("sim:{a}"),
+            Some(a) => Some(format!("sim:{a}")),
             None => anyhow::bail!("the simulated target started without its camera"),
         };
         Ok(SimTarget { sim, camera })
+    }
+
+    /// Serve only the robot's serial port (no camera): the scene's robot and world, or the
+    /// default empty table when `scene` is `None` (`pushbot robot …` without `--port`).
+    pub fn start_robot(scene: Option<&Scene>, seed: u64, speed: f64) -> Result<SimTarget> {
+        let sim = PtySim::start(SimOptions {
+            seed,
+            speed,
+            scene: scene.cloned(),
+            ..SimOptions::default()
+        })
+        .context("starting the built-in simulated robot")?;
+        Ok(SimTarget { sim, camera: None })
     }
 
     /// The robot's serial port (a pty path): `--port`.
@@ -53,9 +68,10 @@ impl SimTarget {
         self.sim.serial_path()
     }
 
-    /// The camera, as `--camera` spells it (`sim:127.0.0.1:PORT`).
+    /// The camera, as `--camera` spells it (`sim:127.0.0.1:PORT`); empty when the target was
+    /// started without one ([`SimTarget::start_robot`]).
     pub fn camera(&self) -> &str {
-        &self.camera
+        self.camera.as_deref().unwrap_or("")
     }
 
     /// The simulator, for ground truth in tests and reports.

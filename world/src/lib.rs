@@ -1,0 +1,26 @@
+//! The shared model of pushbot's table, which the host and the simulated target both stand on:
+//!
+//! * [`Pose`] — the one planar pose (SE(2), on `nalgebra`);
+//! * [`geometry`] — outlines as convex parts and their overlaps, on `parry2d`;
+//! * [`polygon`] — simple-polygon checks in O(n log n) and winding normalisation;
+//! * [`body`] — the robot's build (round bumper, front plate, switches);
+//! * [`scene`] — the one scene format (TOML), its validation with file:line:col errors, and
+//!   [`presets`];
+//! * [`camera`] — the camera model and the markers it sees.
+//!
+//! The table frame has its origin at the table's lower-left corner, x along the width, y along
+//! the height, angles counter-clockwise from +x. This crate depends on neither the firmware nor
+//! the simulator.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod body;
+pub mod camera;
+pub mod geometry;
+pub mod polygon;
+pub mod pose;
+pub mod presets;
+pub mod scene;
+
+pub use pose::{Pose, wrap_angle};
+pub use scene::{Scene, SceneError};

@@ -1,0 +1,231 @@
+//! The checks a scene passes after its fields parse: values in range, polygons simple, goals
+//! and positions on the table, markers drawable and unique; the geometric checks that need
+//! shapes are in [`super::checks`].
+
+use super::error::{Invalid, Seg, invalid, path_string};
+use super::{Marker, Scene, Support, placed, pose_finite};
+
+impl Scene {
+    pub(super) fn check(&self) -> Result<(), Invalid> {
+        use Seg::{Index, Key};
+        let t = self.table;
+        for (k, v) in [("width", t.width), ("height", t.height)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(
+                    vec![Key("table"), Key(k)],
+                    "must be a positive length",
+                ));
+            }
+        }
+        let r = &self.robot;
+        for (k, v) in [
+            ("bumper_radius", r.bumper_radius),
+            ("wheel_base", r.wheel_base),
+            ("wheel_radius", r.wheel_radius),
+            ("no_load_speed", r.no_load_speed),
+            ("stall_torque", r.stall_torque),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(vec![Key("robot"), Key(k)], "must be positive"));
+            }
+        }
+        if r.encoder_cpr == 0 {
+            return Err(invalid(
+                vec![Key("robot"), Key("encoder_cpr")],
+                "must be positive",
+            ));
+        }
+        let s = r.start;
+        let rr = r.bumper_radius;
+        if !(pose_finite(&s)
+            && s.x >= rr
+            && s.x <= t.width - rr
+            && s.y >= rr
+            && s.y <= t.height - rr)
+        {
+            return Err(invalid(
+                vec![Key("robot"), Key("start")],
+                format!("the robot (radius {rr} m) must start on the table"),
+            ));
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            check_polygon(&o.outline)
+                .map_err(|m| invalid(vec![Key("obstacles"), Index(i), Key("outline")], m))?;
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let at = |k| vec![Key("objects"), Index(i), Key(k)];
+            if o.id.is_empty() {
+                return Err(invalid(at("id"), "must not be empty"));
+            }
+            if self.objects[..i].iter().any(|p| p.id == o.id) {
+                return Err(invalid(at("id"), format!("duplicate object id {:?}", o.id)));
+            }
+            check_polygon(&o.outline).map_err(|m| invalid(at("outline"), m))?;
+            if !pose_finite(&o.pose) {
+                return Err(invalid(at("pose"), "must be finite"));
+            }
+            for v in placed(&o.outline, &o.pose) {
+                if !(v[0] >= 0.0 && v[0] <= t.width && v[1] >= 0.0 && v[1] <= t.height) {
+                    return Err(invalid(at("pose"), "the object must lie on the table"));
+                }
+            }
+            if !(o.mass.is_finite() && o.mass > 0.0) {
+                return Err(invalid(at("mass"), "must be positive"));
+            }
+            for (k, v) in [
+                ("support_friction", o.support_friction),
+                ("pusher_friction", o.pusher_friction),
+            ] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(invalid(at(k), "must be a friction coefficient ≥ 0"));
+                }
+            }
+            if o.support_friction == 0.0 {
+                return Err(invalid(
+                    at("support_friction"),
+                    "must be positive (a frictionless object never stops)",
+                ));
+            }
+            if let Support::Points { points, weights } = &o.support {
+                let sp = vec![Key("objects"), Index(i), Key("support")];
+                if points.is_empty() {
+                    return Err(invalid(sp, "needs at least one support point"));
+                }
+                if points.iter().flatten().any(|c| !c.is_finite()) {
+                    return Err(invalid(sp, "support points must be finite"));
+                }
+                if let Some(w) = weights {
+                    if w.len() != points.len() {
+                        return Err(invalid(sp, "needs one weight per support point"));
+                    }
+                    if w.iter().any(|x| !(x.is_finite() && *x >= 0.0))
+                        || w.iter().sum::<f64>() <= 0.0
+                    {
+                        return Err(invalid(sp, "weights must be ≥ 0 and not all 0"));
+                    }
+                }
+            }
+            if let Some(m) = &o.marker
+                && !(m.x.is_finite() && m.y.is_finite() && m.size.is_finite() && m.size > 0.0)
+            {
+                return Err(invalid(
+                    at("marker"),
+                    "needs a finite centre and a positive size",
+                ));
+            }
+        }
+        for (i, g) in self.goals.iter().enumerate() {
+            let at = |k| vec![Key("goals"), Index(i), Key(k)];
+            if self.object(&g.object).is_none() {
+                return Err(invalid(
+                    at("object"),
+                    format!("no object {:?} in the scene", g.object),
+                ));
+            }
+            if !(pose_finite(&g.pose)
+                && g.pose.x >= 0.0
+                && g.pose.x <= t.width
+                && g.pose.y >= 0.0
+                && g.pose.y <= t.height)
+            {
+                return Err(invalid(at("pose"), "must be on the table"));
+            }
+            if !(g.tolerance.is_finite() && g.tolerance > 0.0) {
+                return Err(invalid(at("tolerance"), "must be positive"));
+            }
+            if let Some(a) = g.angle_tolerance
+                && !(a.is_finite() && a > 0.0)
+            {
+                return Err(invalid(at("angle_tolerance"), "must be positive"));
+            }
+        }
+        self.check_markers()?;
+        for (i, p) in self.positions.iter().enumerate() {
+            if !pose_finite(&p.pose) {
+                return Err(invalid(
+                    vec![Key("positions"), Index(i), Key("pose")],
+                    "must be finite",
+                ));
+            }
+        }
+        self.check_geometry()
+    }
+
+    /// Every marker is drawable, calibration markers lie on the table, and no tag id is used
+    /// twice (the camera could not tell the bodies apart).
+    fn check_markers(&self) -> Result<(), Invalid> {
+        use Seg::{Index, Key};
+        let c = &self.camera;
+        if c.width < 64 || c.height < 64 || c.width > 8192 || c.height > 8192 {
+            return Err(invalid(
+                vec![Key("camera"), Key("width")],
+                "the image must be 64..=8192 pixels on each side",
+            ));
+        }
+        if !(c.fps.is_finite() && c.fps > 0.0 && c.fps <= 1000.0) {
+            return Err(invalid(
+                vec![Key("camera"), Key("fps")],
+                "must be a frame rate in (0, 1000]",
+            ));
+        }
+        let drawable =
+            |m: &Marker| m.x.is_finite() && m.y.is_finite() && m.size.is_finite() && m.size > 0.0;
+        let mut used: Vec<(u32, Vec<Seg>)> = Vec::new();
+        let mut add = |id: u32, path: Vec<Seg>| -> Result<(), Invalid> {
+            if id >= 587 {
+                return Err(invalid(
+                    path,
+                    format!("tag id {id} is not in tag36h11 (0..=586)"),
+                ));
+            }
+            if let Some((_, first)) = used.iter().find(|(u, _)| *u == id) {
+                return Err(invalid(
+                    path,
+                    format!("tag id {id} is already used by {}", path_string(first)),
+                ));
+            }
+            used.push((id, path));
+            Ok(())
+        };
+        let rm = vec![Key("camera"), Key("robot_marker")];
+        if !drawable(&c.robot_marker) {
+            return Err(invalid(rm, "needs a finite centre and a positive size"));
+        }
+        add(c.robot_marker.id, rm)?;
+        for (i, o) in self.objects.iter().enumerate() {
+            if let Some(m) = &o.marker {
+                add(m.id, vec![Key("objects"), Index(i), Key("marker")])?;
+            }
+        }
+        for (i, g) in self.goals.iter().enumerate() {
+            if let Some(m) = &g.marker {
+                let at = vec![Key("goals"), Index(i), Key("marker")];
+                if !drawable(m) {
+                    return Err(invalid(at, "needs a finite centre and a positive size"));
+                }
+                add(m.id, at)?;
+            }
+        }
+        let (w, h) = (self.table.width, self.table.height);
+        for (i, m) in self.fiducials().iter().enumerate() {
+            let at = vec![Key("camera"), Key("fiducials"), Index(i)];
+            let half = m.size / 2.0;
+            if !(drawable(m)
+                && m.x - half >= 0.0
+                && m.x + half <= w
+                && m.y - half >= 0.0
+                && m.y + half <= h)
+            {
+                return Err(invalid(at, "a calibration marker must lie on the table"));
+            }
+            add(m.id, at)?;
+        }
+        Ok(())
+    }
+}
+
+/// A usable polygon: ≥ 3 finite vertices, non-zero area, no zero-length edge, no edge
+/// crossing another ([`crate::geometry::check_simple`]).
+fn check_polygon(outline: &[[f64; 2]]) -> Result<(), String> {
+    crate::geometry::check_simple(outline).map_err(|e| e.to_string())
+}
