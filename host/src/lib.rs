@@ -6,6 +6,8 @@
 
 pub mod cli;
 pub mod exec;
+#[cfg(feature = "sim")]
+pub mod experiments;
 pub mod link;
 pub mod mechanics;
 pub mod planner;

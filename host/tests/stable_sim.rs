@@ -11,11 +11,11 @@
 //! closed loop between primitives, aimed from the observed poses) and comes back flush onto the
 //! new edge, and the pushes on both edges must keep the slider on the plate.
 
+use pushbot::exec::stable::{PushRecord, contact_changes, execute as run_plan};
 use pushbot::mechanics::V3;
 use pushbot::planner::stable::exact::finish_exactly;
-use pushbot::planner::stable::execute::{
-    PushRecord, SPEED, contact_changes, execute as run_plan, robot_in_slider, robot_problem,
-    robot_problem_edges, robot_start, sim_scene,
+use pushbot::planner::stable::robot::{
+    SPEED, robot_in_slider, robot_problem, robot_problem_edges, robot_start, sim_scene,
 };
 use pushbot::planner::stable::{Plan, Pose, Problem, angle_diff, plan};
 use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};

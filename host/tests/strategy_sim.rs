@@ -3,9 +3,9 @@
 
 use indicatif::ProgressBar;
 use nalgebra::Vector2;
-use pushbot::strategy::collect::{CollectParams, collect, reset_robot_obj_boundary, safe_spin};
-use pushbot::strategy::deliver::{DeliveryParams, deliver_learned};
-use pushbot::strategy::eval::{Method, TrialSetup, run_start};
+use pushbot::exec::collect::{CollectParams, collect, reset_robot_obj_boundary, safe_spin};
+use pushbot::exec::deliver::{DeliveryParams, deliver_learned};
+use pushbot::experiments::strategy_eval::{Method, TrialSetup, run_start};
 use pushbot::strategy::regression::{KernelParams, PushStrategy};
 use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
 use pushbot::strategy::sample::Sample;
@@ -159,9 +159,8 @@ fn delivery_adds_supplemental_samples_at_once() {
 
 #[test]
 fn collect_once_then_deliver_around_a_wall_from_the_cache() {
-    use pushbot::strategy::obstacles::{
-        ObstacleParams, clearance, collect_and_deliver, collect_or_load, scene_obstacles,
-    };
+    use pushbot::experiments::delivery::{collect_and_deliver, collect_or_load};
+    use pushbot::planner::global::{ObstacleParams, clearance, scene_obstacles};
     let dir = tempfile::tempdir().unwrap();
     let cache = dir.path().join("irregular.strategy");
     let scene = Scene::preset("lau-obstacles").unwrap();

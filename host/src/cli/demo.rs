@@ -287,12 +287,12 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
 
 /// Lau et al.: collect (or reuse) the strategy, deliver among obstacles through the link.
 fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
-    use crate::strategy::collect::CollectParams;
-    use crate::strategy::deliver::DeliveryParams;
+    use crate::exec::collect::CollectParams;
+    use crate::exec::deliver::DeliveryParams;
+    use crate::exec::deliver_path::deliver_among_obstacles;
+    use crate::experiments::delivery::collect_or_load;
+    use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
     use crate::strategy::figures::strategy_svg;
-    use crate::strategy::obstacles::{
-        ObstacleParams, collect_or_load, deliver_among_obstacles, scene_goal, scene_obstacles,
-    };
     use crate::strategy::regression::{KernelParams, PushStrategy};
     use crate::strategy::robot_io::SimRobotOptions;
 
@@ -484,7 +484,8 @@ fn stage_rearrange(
 
 /// Lynch & Mason: plan stable pushes for the plated robot, execute them open loop.
 fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
-    use crate::planner::stable::execute::{execute, robot_problem, robot_start, sim_scene};
+    use crate::exec::stable::execute;
+    use crate::planner::stable::robot::{robot_problem, robot_start, sim_scene};
     use crate::planner::stable::{plan, svg};
 
     let mut st = StageReport::new(

@@ -11,12 +11,16 @@ use pushbot_world::Scene;
 use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
+use crate::exec::collect::{CollectParams, CollectReport, bring_inside, collect};
+use crate::exec::deliver::{DeliveryParams, deliver_dipole, deliver_learned};
+use crate::exec::deliver_path::deliver_among_obstacles;
 use crate::exec::{LiveOptions, LiveRobot};
-use crate::strategy::collect::{CollectParams, CollectReport, bring_inside, collect};
-use crate::strategy::deliver::{DeliveryParams, deliver_dipole, deliver_learned};
-use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start, summarise};
+use crate::experiments::delivery::collect_or_load;
+use crate::experiments::strategy_eval::{
+    Method, StartResult, TrialSetup, parse_starts, run_start, summarise,
+};
+use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
 use crate::strategy::figures;
-use crate::strategy::obstacles;
 use crate::strategy::regression::{KernelParams, PushStrategy};
 use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::Sample;
@@ -488,7 +492,7 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
             })?;
             let file = dir.join(format!("{}.strategy", name.replace(['/', '.'], "_")));
             let pb = progress_bar(global, params.initial as u64);
-            let (samples, rep) = obstacles::collect_or_load(
+            let (samples, rep) = collect_or_load(
                 scene,
                 a.object.as_deref(),
                 &file,
@@ -551,8 +555,7 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     }
     if let Some(svg) = &a.svg {
         if let [scene] = scenes.as_slice() {
-            let goal =
-                obstacles::scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
+            let goal = scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
             let text = figures::trajectories_svg(&trajectories, scene, goal);
             std::fs::write(svg, text)
                 .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
@@ -635,7 +638,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
         ..LiveOptions::default()
     };
     let mut io = LiveRobot::connect(port, camera, scene, opts).map_err(CliError::Failed)?;
-    let goal = obstacles::scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
+    let goal = scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
     let kernel = a.sim.kernel()?;
     let delivery = a.delivery_params()?;
     let mut collection = None;
@@ -676,13 +679,13 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
                 if scene.obstacles.is_empty() {
                     deliver_learned(&mut io, &mut strat, goal, &delivery, &mut |_| Ok(()))?
                 } else {
-                    obstacles::deliver_among_obstacles(
+                    deliver_among_obstacles(
                         &mut io,
                         &mut strat,
                         goal,
-                        &obstacles::scene_obstacles(scene),
+                        &scene_obstacles(scene),
                         &delivery,
-                        &obstacles::ObstacleParams::default(),
+                        &ObstacleParams::default(),
                         &mut |_| Ok(()),
                     )?
                     .delivery

@@ -1,14 +1,24 @@
-//! Execution on a robot seen by a camera: the host's end of the closed loop
-//! (camera → tracking → decision → motion primitive → link → firmware → motors).
+//! Execution: the host's end of the closed loop (camera → tracking → decision → motion
+//! primitive → link → firmware → motors). Each executor runs *look → estimate → plan or correct
+//! → act* on a [`RobotIo`](crate::strategy::robot_io::RobotIo), with the maneuvers written once
+//! in [`maneuver`]:
 //!
-//! [`live::LiveRobot`] is the [`RobotIo`](crate::strategy::robot_io::RobotIo) every planner and
-//! the learned strategy drive, implemented over a real serial link ([`crate::link`]) and a real
-//! camera ([`crate::vision`]): the same code runs a robot on a table and the simulated target
-//! (`pushbot-sim`, or the built-in target `crate::sim::SimTarget`), which it cannot tell apart.
+//! - [`collect`]: Lau et al.'s Algorithm 1 (collecting the pushing strategy);
+//! - [`deliver`]: Algorithm 2 (learned delivery) and the dipole-field baseline;
+//! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals;
+//! - [`stable`]: Lynch & Mason's stable pushes on the plated robot, with transits;
+//! - [`live`]: the [`RobotIo`](crate::strategy::robot_io::RobotIo) over a real serial link
+//!   and a real camera: the same code runs a robot on a table and the simulated target, which
+//!   it cannot tell apart.
 
+pub mod collect;
+pub mod deliver;
+pub mod deliver_path;
 pub mod grabber;
 pub mod live;
+pub mod maneuver;
 pub mod record;
+pub mod stable;
 pub mod view;
 
 pub use live::{LiveOptions, LiveRobot};

@@ -1,4 +1,10 @@
-//! Planners: how the robot moves objects by pushing.
+//! Planners: how the robot moves objects by pushing. Pure functions of a world snapshot and a
+//! goal: no I/O, no robot, no clock; [`crate::exec`] drives their plans.
+//!
+//! - [`rearrange`]: several movables on a grid, optimally (Ben-Shahar & Rivlin).
+//! - [`stable`]: stable pushes among obstacles (Lynch & Mason §4).
+//! - [`global`]: the object's path among obstacles for delivery (Lau et al. §III-E).
 
+pub mod global;
 pub mod rearrange;
 pub mod stable;

@@ -8,16 +8,13 @@
 //! - [`regression`]: k-nearest-neighbour kernel regression of Algorithm 2 (§III-E), general
 //!   and special case, on k-d trees.
 //! - [`dipole`]: the dipole field used as the baseline in §V (Fig. 10–11).
-//! - [`obstacles`]: a global path among obstacles followed through sub-goals (§III-E), and
-//!   "collect (or reuse) then deliver" for a scene.
+//!
+//! The loops that act — collection (Algorithm 1) and delivery (Algorithm 2) — are executors in
+//! [`crate::exec`]; the global path among obstacles is [`crate::planner::global`].
 
 pub mod bench;
-pub mod collect;
-pub mod deliver;
 pub mod dipole;
-pub mod eval;
 pub mod figures;
-pub mod obstacles;
 pub mod regression;
 pub mod robot_io;
 pub mod sample;

@@ -23,6 +23,7 @@ use super::admissibility::MoveKind;
 use super::costmap::CostMap;
 use super::problem::{Config, Dir, Model, Placement, Problem};
 use super::restore::restore;
+use crate::exec::maneuver::{self, Drive, Turn};
 use crate::strategy::robot_io::RobotIo;
 use crate::strategy::sample::{Pose2, wrap_angle};
 
@@ -337,23 +338,15 @@ fn snap_free(model: &Model, frame: &GridFrame, io: &mut dyn RobotIo, q: Config) 
     q
 }
 
-/// Turn to `heading` (rad) from the observed pose.
+/// Turn to `heading` (rad) from the observed pose: one spin.
 fn face(io: &mut dyn RobotIo, heading: f64) -> Result<()> {
-    let now = io.robot_pose().theta;
-    io.spin(wrap_angle(heading - now))
+    maneuver::face(io, heading, &Turn::ONCE)
 }
 
-/// Drive the robot's centre to `target` (turn, then straight).
+/// Drive the robot's centre to `target`: turn, then straight by the distance measured after
+/// the turn (spinning in place may have shifted the centre a little).
 fn drive_to(io: &mut dyn RobotIo, target: Vector2<f64>) -> Result<()> {
-    let p = io.robot_pose();
-    let d = target - p.position();
-    if d.norm() < 0.003 {
-        return Ok(());
-    }
-    face(io, d.y.atan2(d.x))?;
-    // Re-measure after the turn: spinning in place may have shifted the centre a little.
-    let p = io.robot_pose();
-    io.forward((target - p.position()).norm())
+    maneuver::go_to(io, target, &Drive::one_leg(0.003))
 }
 
 /// Carry out the plan from the map until the goal set is reached, re-observing after every

@@ -195,7 +195,7 @@ pub fn finish_exactly(p: &Problem, plan: &Plan) -> Option<Plan> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::planner::stable::execute::robot_problem;
+    use crate::planner::stable::robot::robot_problem;
     use crate::planner::stable::{angle_diff, plan};
 
     #[test]

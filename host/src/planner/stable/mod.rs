@@ -11,7 +11,7 @@
 
 pub mod collision;
 pub mod exact;
-pub mod execute;
+pub mod robot;
 pub mod presets;
 pub mod pusher;
 pub mod search;

@@ -1,10 +1,10 @@
 //! Stable pushes on this project's robot (Lynch & Mason §4, executed as the paper intends: open
-//! loop, no sensing during a push): a preset's pusher replaced by the differential-drive robot
-//! with its flat front plate, the plan turned into one `Velocity` arc of the axle centre per run
-//! of steps with one control, and the simulated scene that matches the problem.
+//! loop, no sensing during a push): the plan of [`crate::planner::stable::robot`]'s problem
+//! (the plated differential-drive robot) driven as one `Velocity` arc per run of steps with
+//! one control.
 //!
 //! Plans may change contact ([`robot_problem_edges`]): between two pushing runs the robot
-//! drives the plan's transit path ([`super::transit`], §4.6's open problem) — straight back off
+//! drives the plan's transit path ([`crate::planner::stable::transit`], §4.6's open problem) — straight back off
 //! the old edge, along the way points of the path for its turning disk, straight onto the new
 //! edge. Transits are closed loop between primitives: each leg is aimed from the observed robot
 //! pose, the way points (planned for the slider at the plan's configuration) are re-anchored to
@@ -15,160 +15,12 @@
 
 use anyhow::{Context, Result, anyhow, bail};
 
-use super::presets::{CostOverride, CostSpec, Scene as StableScene, load_scene};
-use super::transit::TransitPath;
-use super::{Plan, Pose, Problem};
-use crate::mechanics::{V2, V3, cross};
+use crate::exec::maneuver::{Drive, Turn, face, go_to};
+use crate::mechanics::{V2, cross};
+use crate::planner::stable::robot::{SPEED, arcs, robot_in_slider};
+use crate::planner::stable::transit::TransitPath;
+use crate::planner::stable::{Plan, Pose, Problem, angle_diff};
 use crate::strategy::robot_io::RobotIo;
-
-/// The robot's plate: width and distance of its face ahead of the wheel axle (m), as in
-/// `[robot] front_plate` of the simulated scenes.
-pub const PLATE_WIDTH: f64 = 0.12;
-/// See [`PLATE_WIDTH`].
-pub const PLATE_OFFSET: f64 = 0.06;
-/// Pushing speed of the axle centre (m/s): slow, as quasi-static pushing assumes.
-pub const SPEED: f64 = 0.04;
-/// The robot problem's grid cell in x, y, as a fraction of the step. Lynch & Mason §4.2.4 ask
-/// for a grid fine enough that every control moves the configuration to a new cell: the robot
-/// turns about centres on its axle, half a metre out, so a step turns the slider only about as
-/// much as one 6° cell and moves its centre about one step; with cells of a whole step a
-/// diagonal step can stay in its cell and be pruned. Half a step always leaves it. (With whole
-/// steps the search for Fig. 13 on one edge finds a plan or not depending on the order it
-/// expands equal-cost configurations in.)
-pub const ROBOT_GRID_XY_FRAC: f64 = 0.5;
-
-/// The preset `name` with its pusher replaced by the plated differential-drive robot, edge 0
-/// only (no contact changes), with the goal heading `goal_theta_deg` (if given); and the problem
-/// built from it. [`robot_problem_edges`] with `&[0]` and `None`.
-pub fn robot_problem(name: &str, goal_theta_deg: Option<f64>) -> Result<(StableScene, Problem)> {
-    robot_problem_edges(name, goal_theta_deg, &[0], None)
-}
-
-/// The preset (or scene file) `name` with its pusher replaced by the plated differential-drive
-/// robot, pushing on the slider edges `edges` (any of them first), a contact change costing
-/// `contact_cost` (`None`: ∞, no contact changes), with the goal heading tolerance
-/// `goal_theta_deg` (if given); and the problem built from it. The preset's other costs and
-/// search settings are kept, but for the grid's cell in x, y: half a step ([`ROBOT_GRID_XY_FRAC`]).
-pub fn robot_problem_edges(
-    name: &str,
-    goal_theta_deg: Option<f64>,
-    edges: &[usize],
-    contact_cost: Option<u32>,
-) -> Result<(StableScene, Problem)> {
-    if edges.is_empty() {
-        bail!("robot problem {name}: no edge to push on");
-    }
-    let mut s = load_scene(name)?;
-    if let Some(g) = goal_theta_deg {
-        if !(g.is_finite() && g > 0.0) {
-            bail!("robot problem {name}: goal heading tolerance {g}° must be finite and > 0");
-        }
-        s.task.goal_theta_deg = g;
-    }
-    s.pusher.kind = "diff-drive".into();
-    s.pusher.width = Some(PLATE_WIDTH);
-    s.pusher.depth = Some(PLATE_OFFSET + 0.04);
-    s.pusher.axle_offset = Some(PLATE_OFFSET);
-    s.pusher.plate_width = Some(PLATE_WIDTH);
-    s.pusher.min_turning_radius = None;
-    s.task.edges = edges.to_vec();
-    s.task.start_edge = None;
-    s.planner.grid_xy_frac = Some(ROBOT_GRID_XY_FRAC);
-    s.planner.c = Some(match contact_cost {
-        Some(c) => CostSpec::Int(c),
-        None => CostSpec::Word("inf".into()),
-    });
-    let p = s
-        .problem(CostOverride::default())
-        .with_context(|| format!("robot problem {name} on edges {edges:?}"))?;
-    Ok((s, p))
-}
-
-/// The robot's axle centre and heading in the slider frame for contact `ci`.
-pub fn robot_in_slider(p: &Problem, ci: usize) -> (V2, V2) {
-    let pl = &p.contacts[ci].placement;
-    (pl.to_slider(V2::new(0.0, -PLATE_OFFSET)), pl.normal)
-}
-
-/// Where the robot starts: its plate flush on the plan's first contact. `None` without steps.
-pub fn robot_start(p: &Problem, plan: &Plan) -> Option<[f64; 3]> {
-    let ci = plan.steps.first()?.contact;
-    let (axle, heading) = robot_in_slider(p, ci);
-    let a0 = p.start.apply(axle);
-    let h0 = p.start.rotate(heading);
-    Some([a0.x, a0.y, h0.y.atan2(h0.x)])
-}
-
-/// The simulated scene of the problem: the same table and obstacles, the slider (object frame
-/// at its centre of friction, marker `marker_id` on it), the robot with its plate at `start`.
-pub fn sim_scene(
-    s: &StableScene,
-    p: &Problem,
-    start: [f64; 3],
-    marker_id: u32,
-) -> Result<pushbot_world::Scene> {
-    let mut t = format!(
-        "name = \"{}\"\n[table]\nwidth = {}\nheight = {}\n[robot]\nstart = {{ x = {}, y = {}, theta = {} }}\nfront_plate = {{ width = {PLATE_WIDTH}, offset = {PLATE_OFFSET} }}\n",
-        s.name, s.table[0], s.table[1], start[0], start[1], start[2]
-    );
-    for o in &s.obstacles {
-        t += &format!("[[obstacles]]\noutline = {:?}\n", o.polygon);
-    }
-    let outline: Vec<[f64; 2]> = p.slider.vertices.iter().map(|v| [v.x, v.y]).collect();
-    let r = outline
-        .iter()
-        .map(|v| v[0].hypot(v[1]))
-        .fold(f64::INFINITY, f64::min);
-    let size = (r * 1.2).clamp(0.02, 0.05);
-    t += &format!(
-        "[[objects]]\nid = \"slider\"\noutline = {outline:?}\npose = {{ x = {}, y = {}, theta = {} }}\nmass = 0.1\nsupport = {{ kind = \"uniform\" }}\nsupport_friction = 0.3\npusher_friction = {}\nmarker = {{ id = {marker_id}, x = 0.0, y = 0.0, size = {size} }}\n",
-        p.start.x, p.start.y, p.start.theta, s.mu
-    );
-    t += &format!(
-        "[[goals]]\nobject = \"slider\"\npose = {{ x = {}, y = {}, theta = {} }}\ntolerance = {}\n",
-        p.goal.x, p.goal.y, p.goal.theta, p.params.goal_xy
-    );
-    pushbot_world::Scene::from_toml(&t, &format!("stable scene {}", s.name))
-        .map_err(|e| anyhow!("{e}"))
-}
-
-/// One pushing arc of the axle centre: a run of a plan's steps with one contact and one control.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct PushArc {
-    /// Contact (index into the problem's contacts) the robot pushes on.
-    pub contact: usize,
-    /// Distance driven along the heading, m.
-    pub distance: f64,
-    /// Turn, rad (counter-clockwise positive).
-    pub turn: f64,
-}
-
-/// The plan as arcs of the axle centre: per run of steps with one contact and one control, the
-/// distance driven (m, along the heading) and the turn (rad).
-pub fn arcs(p: &Problem, plan: &Plan) -> Vec<PushArc> {
-    let mut runs: Vec<(usize, PushArc)> = Vec::new();
-    for st in &plan.steps {
-        let (axle, heading) = robot_in_slider(p, st.contact);
-        let xi = V3::new(st.twist[0], st.twist[1], st.twist[2]);
-        let u = V2::new(xi.x - xi.z * axle.y, xi.y + xi.z * axle.x);
-        let (d, phi) = (u.dot(&heading), xi.z);
-        match runs.last_mut() {
-            Some((k, a)) if *k == st.control && a.contact == st.contact => {
-                a.distance += d;
-                a.turn += phi;
-            }
-            _ => runs.push((
-                st.control,
-                PushArc {
-                    contact: st.contact,
-                    distance: d,
-                    turn: phi,
-                },
-            )),
-        }
-    }
-    runs.into_iter().map(|(_, a)| a).collect()
-}
 
 /// One executed push: the slider's pose relative to the robot before and after, and how far
 /// the slider moved.
@@ -261,7 +113,7 @@ pub fn execute(p: &Problem, plan: &Plan, io: &mut dyn RobotIo) -> Result<(Vec<Pu
             contact: arc.contact,
             pushed: (s1.x - s0.x).hypot(s1.y - s0.y),
             drift: (q1.x - q0.x).hypot(q1.y - q0.y),
-            drift_angle: super::angle_diff(q1.theta, q0.theta).abs(),
+            drift_angle: angle_diff(q1.theta, q0.theta).abs(),
         });
     }
     let (_, end) = observe(io)?;
@@ -304,33 +156,16 @@ fn flush_pose(p: &Problem, ci: usize, s: &Pose) -> (V2, V2) {
     (s.apply(axle), s.rotate(heading))
 }
 
-/// Turn the robot to heading `h` (a world direction) by spins, measured between, until
-/// within [`HEADING_TOL`] (or out of tries).
-fn face(io: &mut dyn RobotIo, h: V2) -> Result<()> {
-    let want = h.y.atan2(h.x);
-    for _ in 0..TRIES {
-        let e = super::angle_diff(want, io.robot_pose().theta);
-        if e.abs() <= HEADING_TOL {
-            break;
-        }
-        io.spin(e)?;
-    }
-    Ok(())
+/// Turn the robot to face the world direction `h`: spins, measured between, until within
+/// [`HEADING_TOL`] (or out of tries).
+fn face_dir(io: &mut dyn RobotIo, h: V2) -> Result<()> {
+    face(io, h.y.atan2(h.x), &Turn::until(HEADING_TOL, TRIES))
 }
 
 /// Drive the axle centre to `w` (world): turn to face it, drive straight; again from the
 /// observed pose while farther than `tol`.
-fn go_to(io: &mut dyn RobotIo, w: V2, tol: f64) -> Result<()> {
-    for _ in 0..TRIES {
-        let r = io.robot_pose();
-        let d = w - V2::new(r.x, r.y);
-        if d.norm() <= tol {
-            break;
-        }
-        io.spin(super::angle_diff(d.y.atan2(d.x), r.theta))?;
-        io.forward(d.norm())?;
-    }
-    Ok(())
+fn go_to_within(io: &mut dyn RobotIo, w: V2, tol: f64) -> Result<()> {
+    go_to(io, w, &Drive::legs(tol, TRIES))
 }
 
 /// Drive the transit path `tr` from its first contact to its second, the slider staying
@@ -366,7 +201,7 @@ pub fn drive_transit(p: &Problem, tr: &TransitPath, io: &mut dyn RobotIo) -> Res
     io.forward(-(pts[1] - pts[0]).norm())
         .context("backing off the edge")?;
     for (k, w) in pts[2..n - 1].iter().enumerate() {
-        go_to(io, *w, WAYPOINT_TOL).with_context(|| format!("to way point {}", k + 2))?;
+        go_to_within(io, *w, WAYPOINT_TOL).with_context(|| format!("to way point {}", k + 2))?;
     }
     approach(p, tr.to_contact, io).context("onto the new edge")
 }
@@ -395,17 +230,17 @@ pub fn approach(p: &Problem, ci: usize, io: &mut dyn RobotIo) -> Result<()> {
         if cross(h, rel).abs() <= LINE_TOL {
             break;
         }
-        go_to(io, c + h * rel.dot(&h), LINE_TOL / 2.0)?;
+        go_to_within(io, c + h * rel.dot(&h), LINE_TOL / 2.0)?;
     }
     let (_, _, h) = target(io)?;
-    face(io, h)?;
+    face_dir(io, h)?;
     let (r, c, h) = target(io)?;
     let gap = (c - V2::new(r.x, r.y)).dot(&h);
     if gap > CREEP_GAP {
         io.forward(gap - CREEP_GAP)?;
     }
     let (_, _, h) = target(io)?;
-    face(io, h)?;
+    face_dir(io, h)?;
     let (r, c, h) = target(io)?;
     let gap = (c - V2::new(r.x, r.y)).dot(&h);
     io.drive(CREEP_SPEED, 0.0, (gap.max(0.0) + SEAT) / CREEP_SPEED)?;
@@ -423,6 +258,7 @@ pub fn approach(p: &Problem, ci: usize, io: &mut dyn RobotIo) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::planner::stable::robot::{robot_problem, robot_problem_edges};
     use crate::planner::stable::search::Step;
     use crate::planner::stable::transit::{point_segment_distance, transit};
     use crate::strategy::robot_io::{Rect, Workspace};
@@ -534,7 +370,7 @@ mod tests {
         (
             cross(h, rel),
             -rel.dot(&h),
-            super::super::angle_diff(m.r.theta, h.y.atan2(h.x)),
+            super::angle_diff(m.r.theta, h.y.atan2(h.x)),
         )
     }
 

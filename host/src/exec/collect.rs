@@ -22,12 +22,11 @@ use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::deliver::{
-    DeliveryParams, Failure, bound_all_radius, circle_walk, deliver_learned, face,
-};
-use super::regression::PushStrategy;
-use super::robot_io::RobotIo;
-use super::sample::Sample;
+use crate::exec::deliver::{DeliveryParams, Failure, bound_all_radius, deliver_learned};
+use crate::exec::maneuver::{Turn, circle_walk, face};
+use crate::strategy::regression::PushStrategy;
+use crate::strategy::robot_io::RobotIo;
+use crate::strategy::sample::Sample;
 
 /// Parameters of Algorithm 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,7 +110,7 @@ pub fn reset_robot(io: &mut dyn RobotIo, epsilon: f64) -> Result<bool> {
         let r = io.robot_pose();
         let o = io.object_pose();
         let d = o.position() - r.position();
-        face(io, d.y.atan2(d.x), 0.05)?;
+        face(io, d.y.atan2(d.x), &Turn::two_level(0.05))?;
         io.forward(creep)?;
         travelled += creep;
         if (io.object_pose().position() - o0.position()).norm() >= epsilon {
@@ -183,7 +182,7 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             // Aim at the marker, pulled a little towards the table's centre.
             let aim = o.position() + 0.03 * (ws.boundary.centre() - o.position()).normalize();
             let d = aim - r.position();
-            face(io, d.y.atan2(d.x), 0.05)?;
+            face(io, d.y.atan2(d.x), &Turn::two_level(0.05))?;
             io.forward(0.03)?;
             let at = io.object_pose().position();
             let now = distance_outside(&target, at);
@@ -283,7 +282,7 @@ fn stuck(io: &mut dyn RobotIo) -> anyhow::Error {
 }
 
 /// How far `p` lies outside `r`, m (0 inside).
-fn distance_outside(r: &super::robot_io::Rect, p: Vector2<f64>) -> f64 {
+fn distance_outside(r: &crate::strategy::robot_io::Rect, p: Vector2<f64>) -> f64 {
     let dx = (r.min[0] - p.x).max(p.x - r.max[0]).max(0.0);
     let dy = (r.min[1] - p.y).max(p.y - r.max[1]).max(0.0);
     dx.hypot(dy)

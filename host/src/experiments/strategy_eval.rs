@@ -8,11 +8,12 @@ use anyhow::{Result, anyhow};
 use nalgebra::Vector2;
 use pushbot_world::Scene;
 
-use super::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
-use super::obstacles::{ObstacleParams, deliver_among_obstacles, scene_obstacles};
-use super::regression::{KernelParams, PushStrategy};
-use super::robot_io::{RobotIo, SimRobot, SimRobotOptions};
-use super::sample::Sample;
+use crate::exec::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
+use crate::exec::deliver_path::deliver_among_obstacles;
+use crate::planner::global::{ObstacleParams, scene_obstacles};
+use crate::strategy::regression::{KernelParams, PushStrategy};
+use crate::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
+use crate::strategy::sample::Sample;
 
 /// A delivery method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

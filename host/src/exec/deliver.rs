@@ -15,11 +15,12 @@
 use anyhow::Result;
 use nalgebra::Vector2;
 
-use super::dipole::{self, DipoleCommand, DipoleParams};
-use super::obstacles::clearance;
-use super::regression::{PushStrategy, Reposition};
-use super::robot_io::{Rect, RobotIo, Workspace};
-use super::sample::{Pose2, Sample, wrap_angle};
+use crate::exec::maneuver::{Drive, Turn, angle_of, circle_walk, face, go_to};
+use crate::planner::global::robot_fits;
+use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
+use crate::strategy::regression::{PushStrategy, Reposition};
+use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
+use crate::strategy::sample::{Pose2, Sample};
 
 /// Parameters of delivery.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,101 +114,6 @@ pub struct Delivery {
 /// Radius of the bound-all circle (Fig. 3): object bounding radius + robot radius + margin.
 pub fn bound_all_radius(ws: &Workspace, margin: f64) -> f64 {
     ws.object_radius + ws.robot_radius + margin
-}
-
-fn angle_of(v: Vector2<f64>) -> f64 {
-    v.y.atan2(v.x)
-}
-
-/// Spin to `heading`, then once more at the finer level if still off by more than `tol`.
-pub fn face(io: &mut dyn RobotIo, heading: f64, tol: f64) -> Result<()> {
-    let r = io.robot_pose();
-    io.spin(wrap_angle(heading - r.theta))?;
-    let r = io.robot_pose();
-    let err = wrap_angle(heading - r.theta);
-    if err.abs() > tol {
-        io.spin(err)?;
-    }
-    Ok(())
-}
-
-/// Drive to `target`: face it and drive there (coarse), then correct once (fine).
-pub fn go_to(io: &mut dyn RobotIo, target: Vector2<f64>, tol: f64) -> Result<()> {
-    for _ in 0..2 {
-        let r = io.robot_pose();
-        let d = target - r.position();
-        if d.norm() < 0.005 {
-            break;
-        }
-        face(io, angle_of(d), tol)?;
-        io.forward(d.norm())?;
-    }
-    Ok(())
-}
-
-/// Whether the robot's centre may stand at `p`: on the table and clear of every obstacle (by
-/// its radius and 1 cm).
-pub fn robot_fits(ws: &Workspace, obstacles: &[Vec<[f64; 2]>], p: Vector2<f64>) -> bool {
-    ws.reachable().contains(p) && clearance(p, obstacles) > ws.robot_radius + 0.01
-}
-
-/// Move the robot around the circle of radius `radius` about `centre` (Fig. 3 a–c): first to
-/// the circle's closest point, then along it in chords of at most 30° to the point at angle
-/// `to`, going the way that keeps the robot on the table and off the `obstacles` (points the
-/// robot cannot reach are pulled back onto the table).
-pub fn circle_walk(
-    io: &mut dyn RobotIo,
-    centre: Vector2<f64>,
-    radius: f64,
-    to: f64,
-    tol: f64,
-    obstacles: &[Vec<[f64; 2]>],
-) -> Result<()> {
-    let ws = io.workspace();
-    let reach = ws.reachable();
-    let clamp = |p: Vector2<f64>| {
-        Vector2::new(
-            p.x.clamp(reach.min[0], reach.max[0]),
-            p.y.clamp(reach.min[1], reach.max[1]),
-        )
-    };
-    let on = |a: f64| centre + radius * Vector2::new(a.cos(), a.sin());
-    let r = io.robot_pose();
-    let rel = r.position() - centre;
-    let from = if rel.norm() > 1e-9 {
-        angle_of(rel)
-    } else {
-        r.theta + std::f64::consts::PI
-    };
-    if rel.norm() < radius {
-        // Back straight away from the centre onto the circle.
-        face(io, angle_of(-rel), tol)?;
-        let back = clamp(on(from)) - io.robot_pose().position();
-        io.forward(-back.norm())?;
-    } else {
-        go_to(io, clamp(on(from)), tol)?;
-    }
-    let delta = wrap_angle(to - from);
-    let other = if delta >= 0.0 {
-        delta - std::f64::consts::TAU
-    } else {
-        delta + std::f64::consts::TAU
-    };
-    let route = |d: f64| -> Vec<f64> {
-        let n = (d.abs() / 30f64.to_radians()).ceil().max(1.0) as usize;
-        (1..=n).map(|i| from + d * i as f64 / n as f64).collect()
-    };
-    let blocked = |pts: &[f64]| {
-        pts.iter()
-            .filter(|a| !robot_fits(&ws, obstacles, on(**a)))
-            .count()
-    };
-    let (a, b) = (route(delta), route(other));
-    let pts = if blocked(&a) <= blocked(&b) { a } else { b };
-    for ang in pts {
-        go_to(io, clamp(on(ang)), tol)?;
-    }
-    Ok(())
 }
 
 fn path_len(traj: &[(Pose2, Pose2)], pick: fn(&(Pose2, Pose2)) -> Pose2) -> f64 {
@@ -459,7 +365,7 @@ pub fn deliver_learned_among(
                 p.heading_tolerance,
                 obstacles,
             )?;
-            go_to(io, at, p.heading_tolerance)?;
+            go_to(io, at, &Drive::two_level(p.heading_tolerance))?;
             o.vector_to_world(Vector2::new(rep.r[0], rep.r[1]))
         } else {
             let pl = o.point_to_local(r.position());
@@ -476,7 +382,11 @@ pub fn deliver_learned_among(
             };
             o.vector_to_world(Vector2::new(rr[0], rr[1]))
         };
-        face(io, angle_of(dir_world), p.heading_tolerance)?;
+        face(
+            io,
+            angle_of(dir_world),
+            &Turn::two_level(p.heading_tolerance),
+        )?;
         let (r0, o0) = (io.robot_pose(), io.object_pose());
         io.forward(step)?;
         steps += 1;

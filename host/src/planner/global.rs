@@ -1,34 +1,23 @@
-//! Delivery among obstacles, as Lau, Mitani & Igarashi handle it (§III-E, last paragraph):
-//! "we first compute a global collision-free path with existing planning techniques [LaValle],
-//! and then execute the robot to push the object along sub-goals of this path".
+//! The global path of the object among obstacles, for delivery as Lau, Mitani & Igarashi
+//! describe it (§III-E, last paragraph): "we first compute a global collision-free path with
+//! existing planning techniques [LaValle], and then execute the robot to push the object along
+//! sub-goals of this path". A pure planner: a function of the workspace, the obstacles and the
+//! goal; [`crate::exec::deliver_path`] pushes along it.
 //!
-//! The global planner is A* (the `pathfinding` crate) on a grid over the boundary, for the
-//! object's marker. A cell is free when the object's bounding circle (around its marker) clears
-//! every obstacle by a small margin and the marker stays inside the boundary. The robot's room
-//! to push is a cost, not a wall: cells where the robot could not circle the object on its
-//! bound-all circle (Fig. 3) — closer to an obstacle than the object's radius plus the robot's
-//! diameter plus a margin — cost `room_penalty` times as much, so the path keeps that room
-//! wherever the free space allows and squeezes through only where it must.
-//!
-//! Delivery re-plans from the object's current position before each leg and pushes with
-//! Algorithm 2 ([`deliver_learned`]) to the path's point `subgoal_spacing` ahead (a sub-goal,
-//! reached within `subgoal_radius`), until the last leg reaches the goal within the success
-//! radius.
-
-use std::path::Path;
+//! The planner is A* (the `pathfinding` crate) on a grid over the boundary, for the object's
+//! marker. A cell is free when the object's bounding circle (around its marker) clears every
+//! obstacle by a small margin and the marker stays inside the boundary. The robot's room to push
+//! is a cost, not a wall: cells where the robot could not circle the object on its bound-all
+//! circle (Fig. 3) — closer to an obstacle than the object's radius plus the robot's diameter
+//! plus a margin — cost `room_penalty` times as much, so the path keeps that room wherever the
+//! free space allows and squeezes through only where it must.
 
 use anyhow::{Result, anyhow};
-use indicatif::ProgressBar;
 use nalgebra::Vector2;
 use pathfinding::prelude::astar;
 use pushbot_world::Scene;
 
-use super::collect::{CollectParams, CollectReport, collect};
-use super::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};
-use super::regression::{KernelParams, PushStrategy};
-use super::robot_io::{RobotIo, SimRobot, SimRobotOptions, Workspace};
-use super::sample::{Pose2, Sample};
-use super::store::{self, StrategyWriter};
+use crate::strategy::robot_io::Workspace;
 
 /// Parameters of the global path and its sub-goals.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -216,102 +205,10 @@ pub fn point_along(path: &[Vector2<f64>], spacing: f64) -> Option<Vector2<f64>> 
     path.last().copied()
 }
 
-/// How a delivery among obstacles went.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct ObstacleDelivery {
-    /// The whole delivery (time, steps and trajectory over all legs).
-    pub delivery: Delivery,
-    /// The sub-goals pushed to, in order (the last is the goal when reached).
-    pub subgoals: Vec<[f64; 2]>,
-    /// The first global path planned.
-    pub path: Vec<[f64; 2]>,
-}
-
-/// Deliver the object to `goal` among `obstacles` (table-frame polygons): plan a global path,
-/// push along its sub-goals with Algorithm 2, re-planning before every leg.
-pub fn deliver_among_obstacles(
-    io: &mut dyn RobotIo,
-    strategy: &mut PushStrategy,
-    goal: Vector2<f64>,
-    obstacles: &[Vec<[f64; 2]>],
-    params: &DeliveryParams,
-    op: &ObstacleParams,
-    sink: &mut dyn FnMut(&Sample) -> Result<()>,
-) -> Result<ObstacleDelivery> {
-    let start = io.time();
-    let ws = io.workspace();
-    let mut all = Delivery {
-        success: false,
-        failure: None,
-        time: 0.0,
-        steps: 0,
-        repositions: 0,
-        object_path: 0.0,
-        robot_path: 0.0,
-        final_distance: f64::NAN,
-        trajectory: Vec::new(),
-    };
-    let mut subgoals = Vec::new();
-    let mut first_path = Vec::new();
-    let mut legs = 0;
-    loop {
-        let o = io.object_pose().position();
-        let left = params.time_limit - (io.time() - start);
-        let Some(path) = plan_object_path(&ws, obstacles, o, goal, op) else {
-            all.failure = Some(Failure::NoPath);
-            break;
-        };
-        if first_path.is_empty() {
-            first_path = path.iter().map(|v| [v.x, v.y]).collect();
-        }
-        let length: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-        let last = length <= op.subgoal_spacing * 1.5;
-        let sub = if last {
-            goal
-        } else {
-            point_along(&path, op.subgoal_spacing).unwrap_or(goal)
-        };
-        subgoals.push([sub.x, sub.y]);
-        let leg_params = if last {
-            DeliveryParams {
-                time_limit: left,
-                ..*params
-            }
-        } else {
-            DeliveryParams {
-                time_limit: left,
-                success_radius: op.subgoal_radius,
-                fine_radius: op.subgoal_radius,
-                ..*params
-            }
-        };
-        legs += 1;
-        let d = deliver_learned_among(io, strategy, sub, &leg_params, obstacles, sink)?;
-        all.steps += d.steps;
-        all.repositions += d.repositions;
-        all.object_path += d.object_path;
-        all.robot_path += d.robot_path;
-        all.trajectory.extend(d.trajectory);
-        if !d.success {
-            all.failure = d.failure;
-            break;
-        }
-        if last {
-            all.success = true;
-            break;
-        }
-        if legs > 200 {
-            all.failure = Some(Failure::TimeLimit);
-            break;
-        }
-    }
-    all.time = io.time() - start;
-    all.final_distance = (goal - io.object_pose().position()).norm();
-    Ok(ObstacleDelivery {
-        delivery: all,
-        subgoals,
-        path: first_path,
-    })
+/// Whether the robot's centre may stand at `p`: on the table and clear of every obstacle (by
+/// its radius and 1 cm).
+pub fn robot_fits(ws: &Workspace, obstacles: &[Vec<[f64; 2]>], p: Vector2<f64>) -> bool {
+    ws.reachable().contains(p) && clearance(p, obstacles) > ws.robot_radius + 0.01
 }
 
 /// The scene's obstacles as polygons.
@@ -335,94 +232,6 @@ pub fn scene_goal(scene: &Scene, object: Option<&str>) -> Result<Vector2<f64>> {
         .find(|g| g.object == id)
         .ok_or_else(|| anyhow!("scene {} has no goal for {id:?}", scene.name))?;
     Ok(Vector2::new(g.pose.x, g.pose.y))
-}
-
-/// The pushing strategy of `object` in `scene`: loaded from `cache` when that file exists and
-/// has samples, otherwise collected there with Algorithm 1 (on the scene's table without its
-/// obstacles: the strategy belongs to the object, and the paper collects on a clear table) and
-/// written to `cache` sample by sample. Returns the samples and, when it collected, the report.
-pub fn collect_or_load(
-    scene: &Scene,
-    object: Option<&str>,
-    cache: &Path,
-    sim: SimRobotOptions,
-    params: &CollectParams,
-    kernel: KernelParams,
-    pb: &ProgressBar,
-) -> Result<(Vec<Sample>, Option<CollectReport>)> {
-    if cache.exists() {
-        let file = store::load(cache)?;
-        if file.samples.len() >= params.initial.clamp(1, 20) {
-            return Ok((file.samples, None));
-        }
-    }
-    let id = object
-        .map(str::to_owned)
-        .or_else(|| scene.objects.first().map(|o| o.id.clone()))
-        .ok_or_else(|| anyhow!("scene {} has no object", scene.name))?;
-    let (mut writer, existing) = StrategyWriter::open(cache, &id)?;
-    let mut clear = scene.clone();
-    clear.obstacles.clear();
-    let mut io = SimRobot::new(clear, Some(&id), None, sim)?;
-    let mut strategy = PushStrategy::new(existing, kernel);
-    let mut sink = |s: &Sample| -> Result<()> {
-        writer.append(s)?;
-        Ok(())
-    };
-    let rep = collect(&mut io, &mut strategy, params, &mut sink, pb)?;
-    Ok((strategy.samples().to_vec(), Some(rep)))
-}
-
-/// What [`collect_and_deliver`] did.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct SceneDelivery {
-    /// Samples of the strategy used.
-    pub samples: usize,
-    /// The collection's report, when it collected.
-    pub collection: Option<CollectReport>,
-    /// The delivery.
-    pub result: ObstacleDelivery,
-    /// The object's start pose (marker), table frame.
-    pub start: Pose2,
-}
-
-/// Collect (or reuse the cached strategy in `cache`), then deliver the object of `scene` to its
-/// goal among the scene's obstacles, in the in-process simulation: the library entry point of
-/// the demo. `object`: the object's id (the scene's first when `None`).
-// Each argument is a separate, independently defaulted setting of one of the two algorithms.
-#[allow(clippy::too_many_arguments)]
-pub fn collect_and_deliver(
-    scene: &Scene,
-    object: Option<&str>,
-    cache: &Path,
-    sim: SimRobotOptions,
-    collect_params: &CollectParams,
-    delivery: &DeliveryParams,
-    op: &ObstacleParams,
-    pb: &ProgressBar,
-) -> Result<SceneDelivery> {
-    let kernel = KernelParams::default();
-    let (samples, collection) =
-        collect_or_load(scene, object, cache, sim, collect_params, kernel, pb)?;
-    let goal = scene_goal(scene, object)?;
-    let mut io = SimRobot::new(scene.clone(), object, None, sim)?;
-    let start = io.true_object_pose();
-    let mut strategy = PushStrategy::new(samples.iter().copied(), kernel);
-    let result = deliver_among_obstacles(
-        &mut io,
-        &mut strategy,
-        goal,
-        &scene_obstacles(scene),
-        delivery,
-        op,
-        &mut |_| Ok(()),
-    )?;
-    Ok(SceneDelivery {
-        samples: samples.len(),
-        collection,
-        result,
-        start,
-    })
 }
 
 #[cfg(test)]

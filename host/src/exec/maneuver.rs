@@ -1,0 +1,216 @@
+//! The maneuvers every executor drives, written once: turn to a heading ([`face`]), drive the
+//! robot's centre to a point ([`go_to`]), and walk around an object on a circle ([`circle_walk`],
+//! Lau, Mitani & Igarashi Fig. 3). Each measures with the camera ([`RobotIo::robot_pose`]) and
+//! acts with primitives (spin, forward); how often it measures and corrects is the caller's
+//! [`Turn`] and [`Drive`]: the paper's two-level motion (§IV: a coarse spin corrected once at a
+//! finer level), a single open-loop turn, or turns repeated until within a tolerance.
+
+use anyhow::Result;
+use nalgebra::Vector2;
+
+use crate::planner::global::robot_fits;
+use crate::strategy::robot_io::RobotIo;
+use crate::strategy::sample::{Pose2, wrap_angle};
+
+/// How to turn to a heading: up to `tries` spins, each from a fresh measurement, stopping once
+/// within `tol` (rad); with `first_always` the first spin is made however small the error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Turn {
+    /// Heading tolerance, rad.
+    pub tol: f64,
+    /// Most spins.
+    pub tries: usize,
+    /// Spin once before looking at the tolerance.
+    pub first_always: bool,
+}
+
+impl Turn {
+    /// One spin by the measured error, no correction.
+    pub const ONCE: Turn = Turn {
+        tol: 0.0,
+        tries: 1,
+        first_always: true,
+    };
+
+    /// The paper's two levels (§IV): a spin, then one finer spin if still off by more than `tol`.
+    pub fn two_level(tol: f64) -> Turn {
+        Turn {
+            tol,
+            tries: 2,
+            first_always: true,
+        }
+    }
+
+    /// Spins until within `tol`, at most `tries`.
+    pub fn until(tol: f64, tries: usize) -> Turn {
+        Turn {
+            tol,
+            tries,
+            first_always: false,
+        }
+    }
+}
+
+/// How to drive to a point: up to `tries` legs (turn, then straight), each from a fresh
+/// measurement, stopping once within `arrive` (m). With `fresh_turn` the turn measures the
+/// heading again (otherwise it turns from the leg's measurement); with `remeasure` the leg's
+/// length is measured again after the turn (spinning in place shifts the centre a little).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drive {
+    /// Arrival tolerance, m.
+    pub arrive: f64,
+    /// Most legs.
+    pub tries: usize,
+    /// How each leg turns.
+    pub turn: Turn,
+    /// The turn measures the heading again.
+    pub fresh_turn: bool,
+    /// Measure the leg's length again after the turn.
+    pub remeasure: bool,
+}
+
+impl Drive {
+    /// The paper's two-level motion (§IV): two legs, each turning with [`Turn::two_level`];
+    /// arrived within 5 mm.
+    pub fn two_level(tol: f64) -> Drive {
+        Drive {
+            arrive: 0.005,
+            tries: 2,
+            turn: Turn::two_level(tol),
+            fresh_turn: true,
+            remeasure: false,
+        }
+    }
+
+    /// One leg: one turn from a fresh measurement, the length measured again after it; already
+    /// there within `arrive`.
+    pub fn one_leg(arrive: f64) -> Drive {
+        Drive {
+            arrive,
+            tries: 1,
+            turn: Turn::ONCE,
+            fresh_turn: true,
+            remeasure: true,
+        }
+    }
+
+    /// Legs until within `arrive` (at most `tries`), each a single spin from the leg's own
+    /// measurement and a straight drive of the measured distance.
+    pub fn legs(arrive: f64, tries: usize) -> Drive {
+        Drive {
+            arrive,
+            tries,
+            turn: Turn::ONCE,
+            fresh_turn: false,
+            remeasure: false,
+        }
+    }
+}
+
+/// The angle of a vector, rad.
+pub fn angle_of(v: Vector2<f64>) -> f64 {
+    v.y.atan2(v.x)
+}
+
+/// Turn to `heading` (rad, table frame) as `turn` says, measuring the robot's pose first.
+pub fn face(io: &mut dyn RobotIo, heading: f64, turn: &Turn) -> Result<()> {
+    let pose = io.robot_pose();
+    face_from(io, heading, turn, pose)
+}
+
+/// [`face`] from an already measured `pose` (the first spin uses it; later ones measure).
+fn face_from(io: &mut dyn RobotIo, heading: f64, turn: &Turn, mut pose: Pose2) -> Result<()> {
+    for i in 0..turn.tries {
+        if i > 0 {
+            pose = io.robot_pose();
+        }
+        let e = wrap_angle(heading - pose.theta);
+        if !(i == 0 && turn.first_always) && e.abs() <= turn.tol {
+            break;
+        }
+        io.spin(e)?;
+    }
+    Ok(())
+}
+
+/// Drive the robot's centre to `target` (table frame) as `drive` says.
+pub fn go_to(io: &mut dyn RobotIo, target: Vector2<f64>, drive: &Drive) -> Result<()> {
+    for _ in 0..drive.tries {
+        let r = io.robot_pose();
+        let d = target - r.position();
+        if d.norm() <= drive.arrive {
+            break;
+        }
+        if drive.fresh_turn {
+            face(io, angle_of(d), &drive.turn)?;
+        } else {
+            face_from(io, angle_of(d), &drive.turn, r)?;
+        }
+        let length = if drive.remeasure {
+            (target - io.robot_pose().position()).norm()
+        } else {
+            d.norm()
+        };
+        io.forward(length)?;
+    }
+    Ok(())
+}
+
+/// Move the robot around the circle of radius `radius` about `centre` (Fig. 3 a–c): first to
+/// the circle's closest point, then along it in chords of at most 30° to the point at angle
+/// `to`, going the way that keeps the robot on the table and off the `obstacles` (points the
+/// robot cannot reach are pulled back onto the table).
+pub fn circle_walk(
+    io: &mut dyn RobotIo,
+    centre: Vector2<f64>,
+    radius: f64,
+    to: f64,
+    tol: f64,
+    obstacles: &[Vec<[f64; 2]>],
+) -> Result<()> {
+    let ws = io.workspace();
+    let reach = ws.reachable();
+    let clamp = |p: Vector2<f64>| {
+        Vector2::new(
+            p.x.clamp(reach.min[0], reach.max[0]),
+            p.y.clamp(reach.min[1], reach.max[1]),
+        )
+    };
+    let on = |a: f64| centre + radius * Vector2::new(a.cos(), a.sin());
+    let r = io.robot_pose();
+    let rel = r.position() - centre;
+    let from = if rel.norm() > 1e-9 {
+        angle_of(rel)
+    } else {
+        r.theta + std::f64::consts::PI
+    };
+    if rel.norm() < radius {
+        // Back straight away from the centre onto the circle.
+        face(io, angle_of(-rel), &Turn::two_level(tol))?;
+        let back = clamp(on(from)) - io.robot_pose().position();
+        io.forward(-back.norm())?;
+    } else {
+        go_to(io, clamp(on(from)), &Drive::two_level(tol))?;
+    }
+    let delta = wrap_angle(to - from);
+    let other = if delta >= 0.0 {
+        delta - std::f64::consts::TAU
+    } else {
+        delta + std::f64::consts::TAU
+    };
+    let route = |d: f64| -> Vec<f64> {
+        let n = (d.abs() / 30f64.to_radians()).ceil().max(1.0) as usize;
+        (1..=n).map(|i| from + d * i as f64 / n as f64).collect()
+    };
+    let blocked = |pts: &[f64]| {
+        pts.iter()
+            .filter(|a| !robot_fits(&ws, obstacles, on(**a)))
+            .count()
+    };
+    let (a, b) = (route(delta), route(other));
+    let pts = if blocked(&a) <= blocked(&b) { a } else { b };
+    for ang in pts {
+        go_to(io, clamp(on(ang)), &Drive::two_level(tol))?;
+    }
+    Ok(())
+}
