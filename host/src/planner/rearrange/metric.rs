@@ -17,8 +17,11 @@
 //! 8 memory states (direction × "was a translational push"), see [`Model::n_aux`].
 //!
 //! [`Model::n_aux`]: super::problem::Model::n_aux
+//!
+//! Below the problem: it takes only the grid; the bound on one move's cost, which needs the
+//! whole problem, is [`Metric::max_edge`] in `problem/model.rs`.
 
-use super::problem::{Dir, Grid, Problem};
+use super::grid::{Dir, Grid};
 
 /// Metric weights. All costs are integers; every move costs at least 1.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -114,23 +117,6 @@ impl Metric {
             StepKind::Rotate => true,
         };
         self.turn * turns + if change { self.mode_change } else { 0 }
-    }
-
-    /// An upper bound on one move's cost (sizes the bucket queue).
-    pub fn max_edge(&self, p: &Problem, robot_cost: &[u32], push_cost: &[Vec<u32>]) -> u32 {
-        let r = robot_cost.iter().copied().max().unwrap_or(1);
-        let mut pushes: Vec<u32> = push_cost
-            .iter()
-            .map(|v| v.iter().copied().max().unwrap_or(0))
-            .collect();
-        pushes.sort_unstable_by(|a, b| b.cmp(a));
-        let n = if p.rules.max_pushed == 0 {
-            pushes.len()
-        } else {
-            p.rules.max_pushed as usize
-        };
-        let m: u32 = pushes.iter().take(n.max(1)).sum();
-        r + m + 2 * self.turn + self.mode_change
     }
 }
 

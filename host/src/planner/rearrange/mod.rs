@@ -1,6 +1,7 @@
 //! Rearrangement planning of several movables by pushing: Ben-Shahar & Rivlin, "To Push or Not
 //! to Push" (§II problem, §IV algorithm, §V test cases).
 //!
+//! - [`grid`]: the table grid and the four directions, below the problem and the metric;
 //! - [`problem`]: the pushing problem of §II-A on a grid, composite configurations packed into
 //!   integer indices;
 //! - [`admissibility`]: admissible neighbours and origins, §IV-B, computed on the fly;
@@ -10,6 +11,7 @@
 //! - [`cases`]: the test cases A–D of §V-A (scene presets) and reading scenes;
 //! - [`scene`]: the shared scene format (`[rearrange]` section) rasterised to a grid problem;
 //! - [`svg`]: plans drawn as the paper's step-by-step figures;
+//! - [`frame`]: where the grid lies on the table, shared by [`scene`] and [`execute`];
 //! - [`execute`]: plans carried out by the robot on the table, closed on the camera (§V-B).
 //!
 //! Limits (§IV-E): the map holds one `u16` per packed configuration, so memory grows as
@@ -24,6 +26,8 @@ pub mod admissibility;
 pub mod cases;
 pub mod costmap;
 pub mod execute;
+pub mod frame;
+pub mod grid;
 pub mod metric;
 pub mod problem;
 pub mod restore;

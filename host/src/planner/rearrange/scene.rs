@@ -19,7 +19,7 @@ use pushbot_world::Scene;
 use pushbot_world::scene::rearrange::{Field, Rearrange, error_at};
 use pushbot_world::scene::{SceneError, placed};
 
-use super::execute::GridFrame;
+use super::frame::GridFrame;
 use super::metric::Metric;
 use super::problem::{
     Cell, Config, ContactMode, Dir, Grid, MovableSpec, Placement, Problem, RobotSpec, Rules,

@@ -1,0 +1,343 @@
+//! The best-first (A*) search loop of Lynch & Mason (1996) §4.1–4.2: take the cheapest step
+//! from OPEN, check it, prune it on the grid, stop at the goal neighbourhood, MAXCOST or the
+//! node limit, and expand it with every contact's controls; then read the plan back.
+
+use std::collections::{BinaryHeap, HashMap};
+use std::time::Instant;
+
+use super::bound::Heuristic;
+use super::grid::{Cells, Grid};
+use super::open::{Fifo, Open, Pending, Queue};
+use super::steps::{Plan, Step, step_cost, summarise};
+use crate::planner::stable::collision::Frame;
+use crate::planner::stable::transit::{TransitPath, transit};
+use crate::planner::stable::{Pose, Problem};
+
+const NONE: u32 = u32::MAX;
+
+/// When a generated step's collision is checked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Checks {
+    /// When the step is generated, before it enters OPEN (the paper's order, §4.2.1).
+    Eager,
+    /// When its node is taken from OPEN, before the goal test and the grid is marked: a node
+    /// whose cell is already occupied at that time, or that is never taken before the search
+    /// ends, is never checked. The search expands the same nodes in the same order and
+    /// returns the same plan as [`Checks::Eager`] (a colliding node in OPEN is only skipped).
+    Lazy,
+}
+
+/// A configuration taken from OPEN and expanded, or the goal: the search tree's inner nodes.
+#[derive(Clone, Copy)]
+struct Expanded {
+    q: Pose,
+    /// `(sin θ, cos θ)` of `q` (its children's steps and checks use it): the parent's composed
+    /// with the step's rotation, as [`step_ok`] does for the step's end.
+    sc: (f64, f64),
+    /// Whether `q` is in the refined region (§4.5): its children take the fine steps.
+    fine: bool,
+    contact: u32,
+    control: u32,
+    parent: u32,
+    cost: u32,
+    transit: u32,
+}
+
+/// Plan with the paper's bucketed OPEN list.
+pub fn plan(p: &Problem) -> Plan {
+    plan_with(p, Queue::Buckets)
+}
+
+/// Whether the step of contact `ci`, control `k` from `from` (with `sc` = `(sin, cos)` of its
+/// angle, `fine`: whether it is near the goal) to `to` is free along its whole length.
+fn step_ok(
+    p: &Problem,
+    from: &Pose,
+    (sc, fine): ((f64, f64), bool),
+    ci: usize,
+    k: usize,
+    to: &Pose,
+) -> bool {
+    let cm = &p.contacts[ci];
+    let (xi, swept, (sd, cd)) = if fine {
+        (&cm.fine_steps[k], &cm.fine_swept[k], cm.fine_delta_sc[k])
+    } else {
+        (&cm.steps[k], &cm.swept[k], cm.delta_sc[k])
+    };
+    let frame = Frame {
+        x: from.x,
+        y: from.y,
+        s: sc.0,
+        c: sc.1,
+    };
+    // `(sin, cos)` at the step's end, composed from the start's and the step's rotation.
+    let sc2 = compose_sc(sc, (sd, cd));
+    cm.body
+        .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
+}
+
+/// `(sin, cos)` of the sum of two angles given as `(sin, cos)`.
+#[inline(always)]
+fn compose_sc((s, c): (f64, f64), (sd, cd): (f64, f64)) -> (f64, f64) {
+    (s * cd + c * sd, c * cd - s * sd)
+}
+
+/// The transit path (index into `transits`) of a mobile pusher from expanded node `parent`'s
+/// contact to `contact`, found once per pair (§4.6); `None` if there is none.
+fn transit_of(
+    p: &Problem,
+    closed: &[Expanded],
+    cache: &mut HashMap<(u32, u32), Option<u32>>,
+    transits: &mut Vec<TransitPath>,
+    parent: u32,
+    contact: u32,
+) -> Option<u32> {
+    *cache.entry((parent, contact)).or_insert_with(|| {
+        let par = &closed[parent as usize];
+        transit(
+            p,
+            &par.q,
+            par.contact as usize,
+            contact as usize,
+            closed.len() as u32,
+        )
+        .map(|tp| {
+            transits.push(tp);
+            (transits.len() - 1) as u32
+        })
+    })
+}
+
+/// Plan with the given OPEN list.
+///
+/// A* on `f = g + h` ([`Heuristic`]). The paper prunes a configuration whose grid cell was
+/// already reached "with the same or lower cost and the same pushing contact" (§4.2.3); the grid
+/// remembers the least cost `g` each cell was expanded with, so a cell reached again more
+/// cheaply (possible once the order is by `f`, not `g`) is expanded again.
+pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
+    plan_checked(p, queue, Checks::Lazy)
+}
+
+/// Plan with the given OPEN list and collision-check timing ([`Checks`]).
+pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
+    let t0 = Instant::now();
+    let heur = Heuristic::new(p);
+    // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
+    let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
+    let mut transits: Vec<TransitPath> = Vec::new();
+    let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
+    let mut occupied = Grid::new(p);
+    let cells = Cells::new(p);
+    let max_cost = p.params.max_cost;
+    let mut open = match queue {
+        Queue::Buckets => Open::Buckets {
+            lists: vec![Fifo::default(); max_cost as usize + 1],
+            cur: 0,
+            spare: Vec::new(),
+        },
+        Queue::Heap => Open::Heap {
+            heap: BinaryHeap::new(),
+            store: Vec::new(),
+        },
+    };
+    let start_contact = p.start_contact.map_or(NONE, |c| c as u32);
+    open.push(
+        heur.cost(heur.steps(&p.start)),
+        Pending {
+            parent: NONE,
+            contact: start_contact,
+            control: NONE,
+            cost: 0,
+        },
+    );
+    let heur_zero = heur.cost(u32::MAX) == 0;
+    let start_sc = p.start.theta.sin_cos();
+    let lazy = checks == Checks::Lazy;
+    let mobile = p.pusher.is_mobile();
+    let mut expanded = 0usize;
+    let mut goal_node = None;
+    // The start must be free for some contact's body; each step checks its own body.
+    while let Some(n) = open.pop() {
+        // The configuration: the start, or the parent's step (as when it was generated).
+        let q = if n.parent == NONE {
+            p.start
+        } else {
+            let par = &closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let d = if par.fine {
+                &cm.fine_deltas[n.control as usize]
+            } else {
+                &cm.deltas[n.control as usize]
+            };
+            par.q.compose(d, par.sc)
+        };
+        // The node's grid cell (the start, with no contact yet, has none).
+        let key = (n.contact != NONE).then(|| cells.cell(&q, n.contact));
+        let in_goal = p.in_goal(&q);
+        if lazy && n.parent != NONE {
+            // Pruned at the grid test below anyway (unless it is a goal): skip the check.
+            if !in_goal && key.is_some_and(|k| occupied.get(k) <= n.cost) {
+                continue;
+            }
+            let par = &closed[n.parent as usize];
+            if !step_ok(
+                p,
+                &par.q,
+                (par.sc, par.fine),
+                n.contact as usize,
+                n.control as usize,
+                &q,
+            ) {
+                continue;
+            }
+        }
+        let mut transit_id = NONE;
+        if mobile && n.parent != NONE {
+            let par_contact = closed[n.parent as usize].contact;
+            if par_contact != NONE && par_contact != n.contact {
+                match transit_of(
+                    p,
+                    &closed,
+                    &mut transit_cache,
+                    &mut transits,
+                    n.parent,
+                    n.contact,
+                ) {
+                    Some(ti) => transit_id = ti,
+                    None => continue,
+                }
+            }
+        }
+        let node = Expanded {
+            q,
+            sc: (0.0, 1.0),
+            fine: false,
+            contact: n.contact,
+            control: n.control,
+            parent: n.parent,
+            cost: n.cost,
+            transit: transit_id,
+        };
+        if in_goal {
+            closed.push(node);
+            goal_node = Some((closed.len() - 1) as u32);
+            break;
+        }
+        if let Some(key) = key {
+            if occupied.get(key) <= n.cost {
+                continue;
+            }
+            occupied.set(key, n.cost);
+        }
+        if expanded >= p.params.max_nodes {
+            break;
+        }
+        expanded += 1;
+        let prev = (n.contact != NONE).then_some((
+            n.contact as usize,
+            if n.control == NONE {
+                usize::MAX
+            } else {
+                n.control as usize
+            },
+        ));
+        let sc = if n.parent == NONE {
+            start_sc
+        } else {
+            let par = &closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let (sd, cd) = if par.fine {
+                cm.fine_delta_sc[n.control as usize]
+            } else {
+                cm.delta_sc[n.control as usize]
+            };
+            compose_sc(par.sc, (sd, cd))
+        };
+        let fine = cells.near_goal(&q);
+        let me = closed.len() as u32;
+        closed.push(Expanded { sc, fine, ..node });
+        for (ci, cm) in p.contacts.iter().enumerate() {
+            let deltas = if fine { &cm.fine_deltas } else { &cm.deltas };
+            for (k, delta) in deltas.iter().enumerate() {
+                let Some(dc) = step_cost(p, prev, ci, k) else {
+                    continue;
+                };
+                let cost = n.cost.saturating_add(dc);
+                if cost > max_cost {
+                    continue;
+                }
+                let q2 = q.compose(delta, sc);
+                // Both tests only filter; the grid's, more selective, goes first. With `a = 0`
+                // the bound is 0 and is not computed.
+                if occupied.get(cells.cell(&q2, ci as u32)) <= cost {
+                    continue;
+                }
+                let f = if heur_zero {
+                    cost
+                } else {
+                    cost.saturating_add(heur.cost(heur.quick(&q2)))
+                };
+                // The curve of control `k` through `q2` is the one through `q`.
+                let f = f.saturating_add(heur.turn_cost(&q, sc, ci, k));
+                if f > max_cost {
+                    continue;
+                }
+                if !lazy && !step_ok(p, &q, (sc, fine), ci, k, &q2) {
+                    continue;
+                }
+                open.push(
+                    f,
+                    Pending {
+                        parent: me,
+                        contact: ci as u32,
+                        control: k as u32,
+                        cost,
+                    },
+                );
+            }
+        }
+    }
+    let mut plan = Plan {
+        found: false,
+        cost: 0,
+        pushes: 0,
+        control_changes: 0,
+        contact_changes: 0,
+        nodes_expanded: expanded,
+        plan_time_ms: 0.0,
+        steps: vec![],
+        transits: vec![],
+        exact_goal: false,
+    };
+    if let Some(g) = goal_node {
+        let mut chain = Vec::new();
+        let mut i = g;
+        while closed[i as usize].parent != NONE {
+            chain.push(i);
+            i = closed[i as usize].parent;
+        }
+        chain.reverse();
+        for &i in &chain {
+            let n = &closed[i as usize];
+            let par = &closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize];
+            plan.steps.push(Step {
+                contact: n.contact as usize,
+                edge: cm.edge,
+                control: n.control as usize,
+                from: par.q,
+                to: n.q,
+                twist: [xi.x, xi.y, xi.z],
+            });
+            if n.transit != NONE {
+                plan.transits.push(transits[n.transit as usize].clone());
+            }
+        }
+        plan.found = true;
+        plan.cost = closed[g as usize].cost;
+        summarise(p, &mut plan);
+    }
+    plan.plan_time_ms = t0.elapsed().as_secs_f64() * 1e3;
+    plan
+}
