@@ -5,8 +5,8 @@
 use apriltag::{Detector as CDetector, DetectorBuilder, Family, Image};
 use pushbot_world::camera::MarkerFamily;
 
-use super::detect::{DetectError, Detection, Detector, Region, check};
-use super::source::Frame;
+use super::detection::{DetectError, Detection, Detector, Region, check};
+use super::frame::Frame;
 
 /// Settings of the C detector.
 #[derive(Debug, Clone, Copy)]

@@ -8,7 +8,7 @@ use std::path::Path;
 use pushbot_world::camera::Homography;
 use serde::{Deserialize, Serialize};
 
-use super::detect::Detection;
+use super::detection::Detection;
 use super::homography::{fit_homography, reprojection_errors};
 use super::layout::{MarkerLayout, Pose};
 

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::source::{Frame, FrameSource, SourceError};
+use super::frame::{Frame, FrameSource, SourceError};
 
 /// Frames from image files.
 #[derive(Debug)]

@@ -8,8 +8,8 @@ use kornia_apriltag::{AprilTagDecoder, DecodeTagsConfig};
 use kornia_image::{Image, ImageSize};
 use pushbot_world::camera::MarkerFamily;
 
-use super::detect::{DetectError, Detection, Detector, Region, check};
-use super::source::Frame;
+use super::detection::{DetectError, Detection, Detector, Region, check};
+use super::frame::Frame;
 
 /// Settings of the kornia detector.
 #[derive(Debug, Clone, Copy, Default)]

@@ -2,9 +2,11 @@
 //! of the robot, objects and goals (Lau et al. §IV: a ceiling camera tracks markers on the
 //! robot, the object and the goal at 960×720, 30 fps).
 //!
-//! - [`source`]: frame sources behind [`source::FrameSource`] (V4L2, image folder, sim socket);
-//! - [`detect`]: detectors behind [`detect::Detector`]: the reference C AprilTag ([`apriltag`],
-//!   the default) and, with the `kornia` feature, the pure-Rust `kornia-apriltag` (`kornia`);
+//! - [`source`]: frame sources behind [`frame::FrameSource`] (V4L2, image folder, sim socket),
+//!   and [`source::open_source`], which picks one;
+//! - [`detect`]: detectors behind [`detection::Detector`]: the reference C AprilTag
+//!   ([`apriltag`], the default) and, with the `kornia` feature, the pure-Rust
+//!   `kornia-apriltag` (`kornia`); [`detect::make_detector`] picks one;
 //! - [`homography`] and [`calibration`]: pixel → table-plane homography from markers at known
 //!   places;
 //! - [`layout`]: which marker is where (until the shared scene format carries it);
@@ -22,7 +24,9 @@ pub mod apriltag;
 pub mod bench;
 pub mod calibration;
 pub mod detect;
+pub mod detection;
 pub mod folder;
+pub mod frame;
 pub mod homography;
 #[cfg(feature = "kornia")]
 pub mod kornia;
@@ -35,9 +39,9 @@ pub mod v4l2;
 use serde::Serialize;
 
 use calibration::Calibration;
-use detect::{DetectError, Detection, Detector};
+use detection::{DetectError, Detection, Detector};
+use frame::Frame;
 use layout::{MarkerLayout, Pose};
-use source::Frame;
 use tracking::{TrackedPose, Tracker, TrackerParams};
 
 /// One body's pose measured from one detection (before filtering).
@@ -207,7 +211,7 @@ impl Pipeline {
     }
 
     /// The regions around each body's predicted marker, or `None` when the whole frame is due.
-    fn regions(&self, frame: &Frame) -> Option<Vec<detect::Region>> {
+    fn regions(&self, frame: &Frame) -> Option<Vec<detection::Region>> {
         if self.roi.full_every <= 1
             || self.since_full + 1 >= self.roi.full_every
             || self.sightings.is_empty()
@@ -227,7 +231,7 @@ impl Pipeline {
             // The marker's bounding square at any heading, plus the margin on each side.
             let side = s.side_px * std::f64::consts::SQRT_2 + 2.0 * self.roi.margin_px;
             let side = ((side / ROI_STEP).ceil() * ROI_STEP).min(u32::MAX as f64) as u32;
-            out.push(detect::Region::square_around(
+            out.push(detection::Region::square_around(
                 centre,
                 side,
                 frame.width,

@@ -6,7 +6,7 @@ use std::net::TcpStream;
 
 use pushbot_world::camera::FrameHeader;
 
-use super::source::{Frame, FrameSource, SourceError};
+use super::frame::{Frame, FrameSource, SourceError};
 
 /// Largest frame accepted (pixels), so a bad header cannot make us allocate without bound.
 const MAX_PIXELS: u64 = 8192 * 8192;

@@ -9,7 +9,7 @@ use linuxvideo::format::{PixFormat, PixelFormat};
 use linuxvideo::stream::ReadStream;
 use linuxvideo::{BufType, Device};
 
-use super::source::{Frame, FrameSource, SourceError};
+use super::frame::{Frame, FrameSource, SourceError};
 
 /// 8-bit gray (`V4L2_PIX_FMT_GREY`).
 const GREY: PixelFormat = PixelFormat::from_fourcc(*b"GREY");
