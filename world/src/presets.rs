@@ -79,8 +79,13 @@ pub fn text(name: &str) -> Option<String> {
         "lau-snake" => lau(name, SNAKE, [0.0, 0.0], 0.1, SUPPORT_UNIFORM),
         // The irregular object at A behind a wall from the top edge down to y = 0.55 m, leaving a
         // gap of 0.35 m above the boundary of a live run (inset 0.2 m) to push the object through.
+        // Position D of the layout (0.85, 0.95) is inside that wall: here it moves to the
+        // wall's start side, 0.2 m right of A.
         "lau-obstacles" => {
-            lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &obstacle(7.8, 5.5, 8.8, 12.0)
+            lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM).replace(
+                "pose = { x = 0.85, y = 0.95, theta = -1.5708 }",
+                "pose = { x = 0.65, y = 0.95, theta = -1.5708 }",
+            ) + &obstacle(7.8, 5.5, 8.8, 12.0)
         }
         "bsr-a" => bsr_a(),
         "bsr-b" => bsr_b(),

@@ -11,6 +11,7 @@
 //! # calibration markers at known table positions (table frame); default: six 5 cm tags,
 //! # ids 40–45, 6 cm in from the four corners and the middles of the long edges
 //! fiducials = [{ id = 40, x = 0.06, y = 0.06, size = 0.05 }]
+//! intrinsics = "camera.yaml"  # lens model file (camera_info or OpenCV YAML); not read yet
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -35,6 +36,10 @@ pub struct CameraSpec {
     /// Calibration markers fixed on the table, table frame; `None`: the default six.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fiducials: Option<Vec<Marker>>,
+    /// A file with the lens model (ROS `camera_info` YAML or OpenCV YAML), path relative to
+    /// the working directory; not read yet: filled in by the real-camera work.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub intrinsics: Option<String>,
 }
 
 impl Default for CameraSpec {
@@ -48,8 +53,10 @@ impl Default for CameraSpec {
                 x: 0.0,
                 y: 0.0,
                 size: 0.05,
+                z: 0.0,
             },
             fiducials: None,
+            intrinsics: None,
         }
     }
 }
@@ -77,6 +84,7 @@ impl CameraSpec {
             x,
             y,
             size: 0.05,
+            z: 0.0,
         })
         .collect()
     }

@@ -1,10 +1,12 @@
 //! The geometric checks of a scene, after its fields parse and are in range: the robot (with its
 //! front plate) starts on the table and clear of obstacles and objects, and no object overlaps
-//! an obstacle or another object. Shapes and overlaps come from parry2d ([`crate::geometry`]);
+//! an obstacle or another object, every goal puts its object on the table and clear of the
+//! obstacles, and every named position (an object's start, in the layouts that have them) is
+//! on the table and clear of the obstacles. Shapes and overlaps come from parry2d ([`crate::geometry`]);
 //! touching is allowed, overlapping by more than 1 nm is not.
 
-use super::Scene;
 use super::error::{Invalid, Seg, invalid};
+use super::{Scene, placed};
 use crate::body::Body;
 use crate::geometry::Outline;
 use crate::pose::Pose;
@@ -104,6 +106,62 @@ impl Scene {
                 ));
             }
             objects.push(shape);
+        }
+        let on_table = |outline: &[[f64; 2]], at: &Pose| {
+            placed(outline, at)
+                .iter()
+                .all(|v| v[0] >= 0.0 && v[0] <= w && v[1] >= 0.0 && v[1] <= h)
+        };
+        for (i, g) in self.goals.iter().enumerate() {
+            let Some(k) = self.objects.iter().position(|o| o.id == g.object) else {
+                continue;
+            };
+            let what = format!(
+                "goals[{i}] (object {:?}): the goal pose puts the object",
+                g.object
+            );
+            let at = vec![Key("goals"), Index(i), Key("pose")];
+            if !on_table(&self.objects[k].outline, &g.pose) {
+                return Err(invalid(at, format!("{what} off the table")));
+            }
+            for (j, obstacle) in obstacles.iter().enumerate() {
+                if objects[k].overlaps(&g.pose, obstacle, &origin, TOUCH) {
+                    return Err(invalid(at, format!("{what} inside obstacles[{j}]")));
+                }
+            }
+        }
+        // A named position is a start of the scene's object (the layouts with positions have
+        // one): its outline there must be on the table and clear of obstacles; with several
+        // objects, the position's point.
+        for (i, p) in self.positions.iter().enumerate() {
+            let at = vec![Key("positions"), Index(i), Key("pose")];
+            let what = format!("positions[{i}] ({:?})", p.name);
+            let (off, inside) = match (self.objects.as_slice(), objects.as_slice()) {
+                ([o], [shape]) => (
+                    !on_table(&o.outline, &p.pose),
+                    obstacles
+                        .iter()
+                        .position(|ob| shape.overlaps(&p.pose, ob, &origin, TOUCH)),
+                ),
+                _ => (
+                    !(p.pose.x >= 0.0 && p.pose.x <= w && p.pose.y >= 0.0 && p.pose.y <= h),
+                    obstacles
+                        .iter()
+                        .position(|ob| ob.contains(&origin, [p.pose.x, p.pose.y])),
+                ),
+            };
+            if off {
+                return Err(invalid(
+                    at,
+                    format!("{what}: the position is off the table"),
+                ));
+            }
+            if let Some(j) = inside {
+                return Err(invalid(
+                    at,
+                    format!("{what}: the position is inside obstacles[{j}]"),
+                ));
+            }
         }
         Ok(())
     }

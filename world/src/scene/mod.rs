@@ -23,7 +23,7 @@
 //! support = { kind = "uniform" }              # or { kind = "points", points = [[x, y], …], weights = […] }
 //! support_friction = 0.35                     # object–table Coulomb coefficient
 //! pusher_friction = 0.5                       # robot–object Coulomb coefficient
-//! marker = { id = 3, x = 0.0, y = 0.0, size = 0.05 }   # AprilTag tag36h11, object frame
+//! marker = { id = 3, x = 0.0, y = 0.0, size = 0.05, z = 0.03 }   # tag36h11, object frame; z: height above the table
 //!
 //! [[goals]]
 //! object = "box"
@@ -49,6 +49,7 @@ use crate::pose::Pose;
 pub mod camera;
 mod checks;
 mod error;
+mod sections;
 mod validate;
 pub use camera::CameraSpec;
 pub use error::SceneError;
@@ -180,6 +181,13 @@ pub struct Marker {
     /// Side of the tag's black square, m.
     #[serde(default = "default_marker_size")]
     pub size: f64,
+    /// Height of the tag above the table, m (finite, ≥ 0; default 0: on the table).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub z: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn default_marker_size() -> f64 {
@@ -247,10 +255,33 @@ pub struct NamedPose {
     pub pose: Pose,
 }
 
+/// Something the loader changed in a scene that it accepted, for `scene check` to say (e.g. a
+/// clockwise outline stored counter-clockwise).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Note {
+    /// The field, e.g. `obstacles[0].outline`.
+    pub field: String,
+    /// What was done, e.g. `was clockwise; normalised to counter-clockwise`.
+    pub message: String,
+}
+
+impl std::fmt::Display for Note {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}", self.field, self.message)
+    }
+}
+
 impl Scene {
     /// Parse and check a scene; `file` names the source in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Scene, SceneError> {
-        let scene: Scene = toml::from_str(text).map_err(|e| {
+        Scene::from_toml_noted(text, file).map(|(s, _)| s)
+    }
+
+    /// Parse and check a scene, and say what was normalised: outlines are stored
+    /// counter-clockwise (a clockwise one is reversed, keeping vertex 0 first; see
+    /// [`crate::polygon::normalise_ccw`]).
+    pub fn from_toml_noted(text: &str, file: &str) -> Result<(Scene, Vec<Note>), SceneError> {
+        let mut scene: Scene = toml::from_str(text).map_err(|e| {
             let (line, column) = match e.span() {
                 Some(s) => {
                     let (l, c) = line_col(text, s.start);
@@ -282,11 +313,17 @@ impl Scene {
                 message: bad.message,
             });
         }
-        Ok(scene)
+        let notes = scene.normalise();
+        Ok((scene, notes))
     }
 
     /// Read a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Scene::load_noted(path).map(|(s, _)| s)
+    }
+
+    /// Read a scene file, and say what was normalised (see [`Scene::from_toml_noted`]).
+    pub fn load_noted(path: &Path) -> Result<(Scene, Vec<Note>), SceneError> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {
             file: file.clone(),
@@ -299,7 +336,7 @@ impl Scene {
                 format!("cannot read: {e}")
             },
         })?;
-        Scene::from_toml(&text, &file)
+        Scene::from_toml_noted(&text, &file)
     }
 
     /// A built-in preset by name (see [`PRESETS`]).
@@ -318,9 +355,15 @@ impl Scene {
 
     /// A preset by name, or else a file by path.
     pub fn preset_or_file(name_or_path: &str) -> Result<Scene, SceneError> {
+        Scene::preset_or_file_noted(name_or_path).map(|(s, _)| s)
+    }
+
+    /// A preset by name, or else a file by path, and what was normalised (see
+    /// [`Scene::from_toml_noted`]).
+    pub fn preset_or_file_noted(name_or_path: &str) -> Result<(Scene, Vec<Note>), SceneError> {
         let path = Path::new(name_or_path);
         if PRESETS.contains(&name_or_path) {
-            Scene::preset(name_or_path)
+            Scene::preset(name_or_path).map(|s| (s, Vec::new()))
         } else if !path.exists() {
             Err(SceneError {
                 file: name_or_path.to_owned(),
@@ -341,7 +384,7 @@ impl Scene {
                 message: "is a directory, not a scene file (TOML)".to_owned(),
             })
         } else {
-            Scene::load(path)
+            Scene::load_noted(path)
         }
     }
 
@@ -382,17 +425,7 @@ pub fn placed(outline: &[[f64; 2]], pose: &Pose) -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// Signed area (shoelace), positive for counter-clockwise vertices.
-pub fn signed_area(outline: &[[f64; 2]]) -> f64 {
-    let n = outline.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (outline[i], outline[(i + 1) % n]);
-            a[0] * b[1] - b[0] * a[1]
-        })
-        .sum::<f64>()
-        / 2.0
-}
+pub use crate::polygon::signed_area;
 
 fn pose_finite(p: &Pose) -> bool {
     p.is_finite()

@@ -29,8 +29,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::SceneError;
-use super::error::{Seg, line_col, path_string, span_of};
+use super::error::{SceneError, Seg, line_col, path_string, span_of};
 
 /// Grid planning settings of a scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -3,7 +3,7 @@
 //! shapes are in [`super::checks`].
 
 use super::error::{Invalid, Seg, invalid, path_string};
-use super::{Marker, Scene, Support, placed, pose_finite};
+use super::{Marker, Note, Scene, Support, placed, pose_finite};
 
 impl Scene {
     pub(super) fn check(&self) -> Result<(), Invalid> {
@@ -105,13 +105,8 @@ impl Scene {
                     }
                 }
             }
-            if let Some(m) = &o.marker
-                && !(m.x.is_finite() && m.y.is_finite() && m.size.is_finite() && m.size > 0.0)
-            {
-                return Err(invalid(
-                    at("marker"),
-                    "needs a finite centre and a positive size",
-                ));
+            if let Some(m) = &o.marker {
+                marker_ok(m).map_err(|e| invalid(at("marker"), e))?;
             }
         }
         for (i, g) in self.goals.iter().enumerate() {
@@ -148,7 +143,40 @@ impl Scene {
                 ));
             }
         }
+        self.check_sections()?;
         self.check_geometry()
+    }
+
+    /// Store every outline counter-clockwise (reversed keeping vertex 0 first, so the shape is
+    /// the same); the stable task's edge numbers follow its object's outline. Returns what was
+    /// changed.
+    pub(super) fn normalise(&mut self) -> Vec<Note> {
+        use crate::polygon::{normalise_ccw, reversed_edge};
+        let note = |field: String, extra: &str| Note {
+            field,
+            message: format!("was clockwise; normalised to counter-clockwise{extra}"),
+        };
+        let mut notes = Vec::new();
+        for (i, o) in self.obstacles.iter_mut().enumerate() {
+            if normalise_ccw(&mut o.outline) {
+                notes.push(note(format!("obstacles[{i}].outline"), ""));
+            }
+        }
+        for (i, o) in self.objects.iter_mut().enumerate() {
+            let n = o.outline.len();
+            if !normalise_ccw(&mut o.outline) {
+                continue;
+            }
+            let mut extra = "";
+            if let Some(st) = self.stable.as_mut().filter(|st| st.object == o.id) {
+                for e in st.edges.iter_mut().chain(st.start_edge.as_mut()) {
+                    *e = reversed_edge(*e, n);
+                }
+                extra = " (edge i is now edge n − 1 − i: stable.edges renumbered)";
+            }
+            notes.push(note(format!("objects[{i}].outline"), extra));
+        }
+        notes
     }
 
     /// Every marker is drawable, calibration markers lie on the table, and no tag id is used
@@ -168,8 +196,7 @@ impl Scene {
                 "must be a frame rate in (0, 1000]",
             ));
         }
-        let drawable =
-            |m: &Marker| m.x.is_finite() && m.y.is_finite() && m.size.is_finite() && m.size > 0.0;
+        let drawable = |m: &Marker| marker_ok(m).is_ok();
         let mut used: Vec<(u32, Vec<Seg>)> = Vec::new();
         let mut add = |id: u32, path: Vec<Seg>| -> Result<(), Invalid> {
             if id >= 587 {
@@ -188,8 +215,8 @@ impl Scene {
             Ok(())
         };
         let rm = vec![Key("camera"), Key("robot_marker")];
-        if !drawable(&c.robot_marker) {
-            return Err(invalid(rm, "needs a finite centre and a positive size"));
+        if let Err(e) = marker_ok(&c.robot_marker) {
+            return Err(invalid(rm, e));
         }
         add(c.robot_marker.id, rm)?;
         for (i, o) in self.objects.iter().enumerate() {
@@ -200,8 +227,8 @@ impl Scene {
         for (i, g) in self.goals.iter().enumerate() {
             if let Some(m) = &g.marker {
                 let at = vec![Key("goals"), Index(i), Key("marker")];
-                if !drawable(m) {
-                    return Err(invalid(at, "needs a finite centre and a positive size"));
+                if let Err(e) = marker_ok(m) {
+                    return Err(invalid(at, e));
                 }
                 add(m.id, at)?;
             }
@@ -222,6 +249,17 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// A drawable marker: a finite centre, a positive size, a finite height `z` ≥ 0.
+fn marker_ok(m: &Marker) -> Result<(), &'static str> {
+    if !(m.x.is_finite() && m.y.is_finite() && m.size.is_finite() && m.size > 0.0) {
+        return Err("needs a finite centre and a positive size");
+    }
+    if !(m.z.is_finite() && m.z >= 0.0) {
+        return Err("z (its height above the table, m) must be finite and ≥ 0");
+    }
+    Ok(())
 }
 
 /// A usable polygon: ≥ 3 finite vertices, non-zero area, no zero-length edge, no edge
