@@ -27,6 +27,27 @@ cargo fmt --all -- --check
 say "lints"
 cargo clippy --workspace --all-targets -- -D warnings
 
+# The host stands on the world crate and the protocol; the simulator is only behind its default
+# feature `sim` (issue 18). Without it neither the simulator nor the firmware is in its tree, it
+# builds, and a command that would need the built-in target says so (exit 2).
+say "host without the simulator"
+if cargo tree -p pushbot --no-default-features -e normal --prefix none \
+  | grep -E '^pushbot-(sim|firmware) '; then
+  echo "pushbot --no-default-features depends on the simulator or the firmware" >&2
+  exit 1
+fi
+cargo clippy -p pushbot --no-default-features --lib --bins -- -D warnings
+cargo build -p pushbot --no-default-features
+set +e
+msg=$(target/debug/pushbot robot info 2>&1)
+code=$?
+set -e
+echo "$msg"
+if [ "$code" -ne 2 ] || ! grep -q "no simulated target" <<<"$msg"; then
+  echo "pushbot without the sim feature: expected exit 2 naming the missing simulated target, got $code" >&2
+  exit 1
+fi
+
 if [ -x firmware/build-boards.sh ] || [ -f firmware/build-boards.sh ]; then
   say "board firmware"
   bash firmware/build-boards.sh

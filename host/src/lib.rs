@@ -6,7 +6,6 @@
 
 pub mod cli;
 pub mod exec;
-#[cfg(feature = "sim")]
 pub mod experiments;
 pub mod link;
 pub mod mechanics;

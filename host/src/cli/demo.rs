@@ -11,23 +11,18 @@
 //!    them open loop.
 //!
 //! It writes a report folder (`report.html`, `summary.json`, figures, `demo.log`) and prints its
-//! path.
+//! path. The pipeline is [`crate::experiments::demo`]; this module parses and prints.
 
-use std::io::Write;
 use std::path::PathBuf;
+#[cfg(feature = "sim")]
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use pushbot_world::Scene;
 
-use super::{CliError, CliResult, Global, Status};
-use crate::exec::record::{Recorder, TracePoint, TruthProbe};
-use crate::exec::{LiveOptions, LiveRobot};
-use crate::report::{Report, StageReport, figure};
-use crate::sim::SimTarget;
-use crate::strategy::sample::Pose2;
+#[cfg(feature = "sim")]
+use super::Status;
+use super::{CliError, CliResult, Global};
 
 /// The stages, in the order they run.
 pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
@@ -72,91 +67,6 @@ pub struct DemoArgs {
     /// with detected markers, tracked poses and the current path, refreshed after every look).
     #[arg(long)]
     pub view: bool,
-}
-
-/// Everything a stage needs.
-struct Ctx<'a> {
-    args: &'a DemoArgs,
-    g: &'a Global,
-    report: Report,
-    log: std::fs::File,
-}
-
-impl Ctx<'_> {
-    fn log(&mut self, line: &str) {
-        let _ = writeln!(self.log, "{line}");
-        tracing::info!("{line}");
-    }
-
-    fn bar(&self, stage: &str) -> ProgressBar {
-        let pb = if self.g.json {
-            ProgressBar::hidden()
-        } else {
-            ProgressBar::new_spinner()
-        };
-        pb.set_style(
-            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {prefix:10} {wide_msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-        );
-        pb.set_prefix(stage.to_string());
-        pb.enable_steady_tick(std::time::Duration::from_millis(120));
-        pb
-    }
-
-    /// Run `f` on the robot: the built-in simulated target serving `scene`, or the real one.
-    fn with_robot<T>(
-        &mut self,
-        scene: &Scene,
-        object: Option<&str>,
-        ids: &[String],
-        f: impl FnOnce(&mut Recorder<'_>) -> Result<T>,
-    ) -> Result<(T, Vec<TracePoint>)> {
-        let speed = if self.args.port.is_some() {
-            1.0
-        } else {
-            self.args.speed
-        };
-        let opts = LiveOptions {
-            object: object.map(str::to_owned),
-            watchdog_ms: (1000.0 * speed.max(1.0)).min(5000.0) as u16,
-            view_dir: self.args.view.then(|| self.args.out.join("live")),
-            ..LiveOptions::default()
-        };
-        match (&self.args.port, &self.args.camera) {
-            (Some(port), Some(camera)) => {
-                let mut live = LiveRobot::connect(port, camera, scene, opts)?;
-                let mut rec = Recorder::new(&mut live, ids, None);
-                let out = f(&mut rec)?;
-                Ok((out, rec.into_trace()))
-            }
-            _ => {
-                let target = SimTarget::start(scene, self.g.seed, speed, None)?;
-                self.log(&format!(
-                    "simulated target: serial {} camera {}",
-                    target.port(),
-                    target.camera()
-                ));
-                let result = {
-                    let mut live = LiveRobot::connect(target.port(), target.camera(), scene, opts)?;
-                    let probe: TruthProbe<'_> = Box::new(|| {
-                        let t = target.sim().truth().pose;
-                        let objects = target
-                            .sim()
-                            .objects()
-                            .into_iter()
-                            .map(|(id, p)| (id, Pose2::new(p.x, p.y, p.theta)))
-                            .collect();
-                        (Pose2::new(t.x, t.y, t.theta), objects)
-                    });
-                    let mut rec = Recorder::new(&mut live, ids, Some(probe));
-                    let out = f(&mut rec);
-                    out.map(|o| (o, rec.into_trace()))
-                };
-                target.shutdown()?;
-                result
-            }
-        }
-    }
 }
 
 /// The scene a stage runs on: `--scene STAGE=…` or the default.
@@ -214,14 +124,38 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
         crate::exec::grabber::FrameGrabber::open(camera, 30.0)
             .map_err(|e| CliError::bad_input(format!("--camera {camera}: {e}")))?;
     }
-    let report = Report::create(&args.out, "pushbot demo", args.png).map_err(CliError::Failed)?;
-    let log = std::fs::File::create(args.out.join("demo.log"))
-        .map_err(|e| CliError::Failed(anyhow!("creating demo.log: {e}")))?;
-    let mut ctx = Ctx {
-        args: &args,
+    run_stages(
         g,
-        report,
-        log,
+        &args,
+        strategy_scene,
+        (rearrange_case, rearrange_problem),
+        stable_name,
+    )
+}
+
+/// Run the checked stages and print the outcome.
+#[cfg(feature = "sim")]
+fn run_stages(
+    g: &Global,
+    args: &DemoArgs,
+    strategy_scene: Scene,
+    rearrange: (String, crate::planner::rearrange::Problem),
+    stable_name: String,
+) -> CliResult {
+    use crate::experiments::demo::{DemoOptions, run};
+    let opts = DemoOptions {
+        out: args.out.clone(),
+        stages: args.stages.clone(),
+        strategy_scene,
+        rearrange,
+        stable_name,
+        robot: args.port.clone().zip(args.camera.clone()),
+        speed: args.speed,
+        seed: g.seed,
+        png: args.png,
+        cache: args.cache.clone(),
+        view: args.view,
+        quiet: g.json,
     };
     let t0 = Instant::now();
     if args.view && !g.json {
@@ -230,45 +164,18 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
             args.out.join("live").join("live.html").display()
         );
     }
-    for stage in &args.stages {
-        let started = Instant::now();
-        let result = match stage.as_str() {
-            "strategy" => stage_strategy(&mut ctx, &strategy_scene),
-            "rearrange" => stage_rearrange(&mut ctx, &rearrange_case, &rearrange_problem),
-            _ => stage_stable(&mut ctx, &stable_name),
-        };
-        let mut rep = match result {
-            Ok(r) => r,
-            Err(e) => {
-                let mut r = StageReport::new(stage, stage, "");
-                r.notes.push(format!("error: {e:#}"));
-                r
-            }
-        };
-        rep.wall_s = started.elapsed().as_secs_f64();
-        ctx.log(&format!(
-            "stage {stage}: {} in {:.1} s wall, {:.1} s mission time",
-            if rep.success { "reached" } else { "FAILED" },
-            rep.wall_s,
-            rep.mission_s
-        ));
-        for n in &rep.notes {
-            ctx.log(&format!("  {n}"));
-        }
-        ctx.report.add(rep);
-    }
-    let page = ctx.report.write().map_err(CliError::Failed)?;
-    let ok = ctx.report.success();
+    let (report, page) = run(&opts).map_err(CliError::Failed)?;
+    let ok = report.success();
     if g.json {
         let v = serde_json::json!({
             "report": page,
             "success": ok,
             "wall_s": t0.elapsed().as_secs_f64(),
-            "stages": ctx.report.stages(),
+            "stages": report.stages(),
         });
         println!("{v}");
     } else {
-        for s in ctx.report.stages() {
+        for s in report.stages() {
             println!(
                 "{:10} {:8} {:6.1} s",
                 s.id,
@@ -285,274 +192,15 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
     })
 }
 
-/// Lau et al.: collect (or reuse) the strategy, deliver among obstacles through the link.
-fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
-    use crate::exec::collect::CollectParams;
-    use crate::exec::deliver::DeliveryParams;
-    use crate::exec::deliver_path::deliver_among_obstacles;
-    use crate::experiments::delivery::collect_or_load;
-    use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
-    use crate::strategy::figures::strategy_svg;
-    use crate::strategy::regression::{KernelParams, PushStrategy};
-    use crate::strategy::robot_io::SimRobotOptions;
-
-    let mut st = StageReport::new(
-        "strategy",
-        "Learned pushing strategy: deliver an irregular object among obstacles",
-        "Lau, Mitani & Igarashi §III-C–E (Algorithms 1, 2)",
-    );
-    let object = scene
-        .objects
-        .first()
-        .ok_or_else(|| anyhow!("scene {} has no object", scene.name))?
-        .clone();
-    let cache_dir = ctx
-        .args
-        .cache
-        .clone()
-        .unwrap_or_else(|| ctx.args.out.join("cache"));
-    std::fs::create_dir_all(&cache_dir)
-        .with_context(|| format!("creating {}", cache_dir.display()))?;
-    let cache = cache_dir.join(format!("{}-{}.strategy", scene.name, object.id));
-    let pb = ctx.bar("strategy");
-    pb.set_message(format!(
-        "pushing strategy for {} ({})",
-        object.id,
-        cache.display()
-    ));
-    let kernel = KernelParams::default();
-    let sim = SimRobotOptions {
-        seed: ctx.g.seed,
-        ..SimRobotOptions::default()
-    };
-    let (samples, collection) = collect_or_load(
-        scene,
-        Some(&object.id),
-        &cache,
-        sim,
-        &CollectParams::default(),
-        kernel,
-        &pb,
-    )?;
-    st.number("samples", samples.len());
-    st.number("collected_now", collection.is_some());
-    if let Some(c) = &collection {
-        st.number("collection", serde_json::to_value(c)?);
-    }
-    let marker = object.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
-    let outline: Vec<[f64; 2]> = object
-        .outline
-        .iter()
-        .map(|v| [v[0] - marker[0], v[1] - marker[1]])
-        .collect();
-    let f = ctx
-        .report
-        .figure("strategy-samples", &strategy_svg(&samples, &outline))?;
-    st.figures.push((
-        f,
-        format!(
-            "The pushing strategy of {} (Fig. 7): each sample's robot motion from where it pushed, and the object's motion",
-            object.id
-        ),
-    ));
-    pb.set_message("delivering through the serial port and the camera");
-    let goal = scene_goal(scene, Some(&object.id))?;
-    let obstacles = scene_obstacles(scene);
-    let ids = vec![object.id.clone()];
-    let (res, trace) = ctx.with_robot(scene, Some(&object.id), &ids, |io| {
-        let mut strategy = PushStrategy::new(samples.iter().copied(), kernel);
-        deliver_among_obstacles(
-            io,
-            &mut strategy,
-            goal,
-            &obstacles,
-            &DeliveryParams::default(),
-            &ObstacleParams::default(),
-            &mut |_| Ok(()),
-        )
-    })?;
-    pb.finish_and_clear();
-    let d = &res.delivery;
-    st.success = d.success;
-    st.mission_s = d.time;
-    st.number("steps", d.steps);
-    st.number("repositions", d.repositions);
-    st.number("subgoals", res.subgoals.len());
-    st.number("final_distance_m (camera)", d.final_distance);
-    if let Some(last) = trace.last().and_then(|p| p.truth.clone()) {
-        let m = scene_marker_truth(&object, &last.1);
-        if let Some(m) = m {
-            st.number(
-                "final_distance_m (truth)",
-                (m[0] - goal.x).hypot(m[1] - goal.y),
-            );
-        }
-    }
-    if let Some(why) = &d.failure {
-        st.notes.push(format!("delivery failed: {why:?}"));
-    }
-    st.notes.push(format!(
-        "{} samples ({}); delivered in {} pushes, {:.0} s of mission time",
-        samples.len(),
-        if collection.is_some() {
-            "collected now"
-        } else {
-            "from the cache"
-        },
-        d.steps,
-        d.time
-    ));
-    let f = ctx.report.figure(
-        "strategy-delivery",
-        &figure::run_svg(scene, &trace, "delivery among obstacles (truth)", true),
-    )?;
-    st.figures.push((
-        f,
-        "Delivery (Fig. 8): robot blue, object red, start dashed, goal green".into(),
-    ));
-    Ok(st)
-}
-
-/// Where the object's marker truly is, from its true body pose.
-fn scene_marker_truth(
-    object: &pushbot_world::scene::Object,
-    truth: &[(String, Pose2)],
-) -> Option<[f64; 2]> {
-    let (_, p) = truth.iter().find(|(id, _)| *id == object.id)?;
-    let m = object.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
-    let (s, c) = p.theta.sin_cos();
-    Some([p.x + c * m[0] - s * m[1], p.y + s * m[0] + c * m[1]])
-}
-
-/// Ben-Shahar & Rivlin: cost map, restoration, execution through the link with snapping.
-fn stage_rearrange(
-    ctx: &mut Ctx<'_>,
-    case: &str,
-    problem: &crate::planner::rearrange::Problem,
-) -> Result<StageReport> {
-    use crate::planner::rearrange::execute::{ExecOptions, SceneOptions, execute, scene_for};
-    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg};
-
-    let mut st = StageReport::new(
-        "rearrange",
-        &format!("Optimal rearrangement of {case} by pushing"),
-        "Ben-Shahar & Rivlin §IV (cost map, restoration), §V",
-    );
-    let pb = ctx.bar("rearrange");
-    pb.set_message("cost map");
-    let model = Model::new(problem).map_err(|e| anyhow!("{e}"))?;
-    let map = cost_map(&model).map_err(|e| anyhow!("{e}"))?;
-    st.number("states_mapped", map.stats.states_mapped);
-    st.number("map_ms", map.stats.map_ms);
-    let start = model
-        .pack(&problem.start)
-        .ok_or_else(|| anyhow!("the start of {case} is not free"))?;
-    let plan = restore(&model, &map, start).map_err(|e| anyhow!("{e}"))?;
-    st.number("plan_cost", plan.cost);
-    st.number("plan_steps", plan.steps.len());
-    let f = ctx
-        .report
-        .figure("rearrange-plan", &plan_svg(&model, &plan))?;
-    st.figures
-        .push((f, format!("The optimal plan of {case}, step by step")));
-    let scene_opts = SceneOptions::default();
-    let scene = scene_for(problem, &scene_opts)?;
-    let ids: Vec<String> = scene.objects.iter().map(|o| o.id.clone()).collect();
-    pb.set_message("executing through the serial port and the camera");
-    let exec = ExecOptions {
-        cell: scene_opts.cell,
-        fill: scene_opts.fill,
-        ..ExecOptions::default()
-    };
-    let (rep, trace) = ctx.with_robot(&scene, None, &ids, |io| execute(&model, &map, io, &exec))?;
-    pb.finish_and_clear();
-    st.success = rep.reached;
-    st.mission_s = rep.time_s;
-    st.number("executed_cost", rep.executed_cost);
-    st.number("pushes", rep.pushes);
-    st.number("deviations_snapped", rep.deviations);
-    let f = ctx.report.figure(
-        "rearrange-run",
-        &figure::run_svg(&scene, &trace, "executed rearrangement (truth)", true),
-    )?;
-    st.figures.push((
-        f,
-        "Execution on the simulated target: robot blue, boxes red".into(),
-    ));
-    Ok(st)
-}
-
-/// Lynch & Mason: plan stable pushes for the plated robot, execute them open loop.
-fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
-    use crate::exec::stable::execute;
-    use crate::planner::stable::robot::{robot_problem, robot_start, sim_scene};
-    use crate::planner::stable::{plan, svg};
-
-    let mut st = StageReport::new(
-        "stable",
-        &format!("Stable pushing of the slider among obstacles ({name})"),
-        "Lynch & Mason §3 (STABLE), §4 (planner)",
-    );
-    let pb = ctx.bar("stable");
-    pb.set_message("planning stable pushes for the plated robot");
-    let (s, p) = robot_problem(name, None)?;
-    let pl = plan(&p);
-    st.number("found", pl.found);
-    st.number("plan_cost", pl.cost);
-    st.number("pushes_planned", pl.pushes);
-    st.number("nodes_expanded", pl.nodes_expanded);
-    st.number("plan_ms", pl.plan_time_ms);
-    let f = ctx
-        .report
-        .figure("stable-plan", &svg::render(&p, Some(&pl)))?;
-    st.figures
-        .push((f, "The plan over stable pushes (Fig. 13–18 style)".into()));
-    if !pl.found {
-        st.notes
-            .push("no plan of stable pushes exists for this robot".into());
-        return Ok(st);
-    }
-    let start = robot_start(&p, &pl).ok_or_else(|| anyhow!("the plan has no step"))?;
-    let scene = sim_scene(&s, &p, start, 1)?;
-    pb.set_message("pushing open loop through the serial port");
-    let ids = vec!["slider".to_string()];
-    let ((pushes, end), trace) =
-        ctx.with_robot(&scene, Some("slider"), &ids, |io| execute(&p, &pl, io))?;
-    pb.finish_and_clear();
-    let pushed: f64 = pushes.iter().map(|r| r.pushed).sum();
-    let worst = pushes
-        .iter()
-        .map(|r| r.drift / r.pushed.max(0.01))
-        .fold(0.0, f64::max);
-    let worst_angle = pushes.iter().map(|r| r.drift_angle).fold(0.0, f64::max);
-    st.success = p.in_goal(&end);
-    st.mission_s = trace.last().map_or(0.0, |t| t.t - trace[0].t);
-    st.number("pushed_m", pushed);
-    st.number("worst_drift_per_100mm_mm", worst * 100.0);
-    st.number("worst_drift_deg", worst_angle.to_degrees());
-    st.number("end_x", end.x);
-    st.number("end_y", end.y);
-    st.number("end_theta_deg", end.theta.to_degrees());
-    if !st.success {
-        st.notes.push(format!(
-            "the slider ended at ({:.3}, {:.3}, {:.1}°), outside the goal neighbourhood",
-            end.x,
-            end.y,
-            end.theta.to_degrees()
-        ));
-    }
-    let f = ctx.report.figure(
-        "stable-run",
-        &figure::run_svg(
-            &scene,
-            &trace,
-            "stable pushes executed open loop (truth)",
-            true,
-        ),
-    )?;
-    st.figures.push((
-        f,
-        "Open-loop execution: the slider stays on the plate".into(),
-    ));
-    Ok(st)
+/// Without the `sim` feature the demo's strategy stage (collected in the simulation) cannot
+/// run: say so.
+#[cfg(not(feature = "sim"))]
+fn run_stages(
+    _g: &Global,
+    _args: &DemoArgs,
+    _strategy_scene: Scene,
+    _rearrange: (String, crate::planner::rearrange::Problem),
+    _stable_name: String,
+) -> CliResult {
+    Err(super::no_simulated_target())
 }

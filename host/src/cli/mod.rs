@@ -16,6 +16,8 @@ pub mod robot;
 pub mod scene;
 pub mod stable;
 pub mod strategy;
+#[cfg(feature = "sim")]
+mod strategy_sim;
 pub mod vision;
 
 /// Flags every command takes.

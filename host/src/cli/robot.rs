@@ -187,6 +187,14 @@ impl Target {
         Err(crate::cli::no_simulated_target())
     }
 
+    /// Whether the robot is the built-in simulated one.
+    fn simulated(&self) -> bool {
+        #[cfg(feature = "sim")]
+        return self.sim.is_some();
+        #[cfg(not(feature = "sim"))]
+        false
+    }
+
     fn close(self) {
         #[cfg(feature = "sim")]
         if let Some(sim) = self.sim
@@ -223,7 +231,7 @@ pub fn run(global: &Global, args: RobotArgs) -> CliResult {
     let target = Target::open(&args, global.seed)?;
     let result = (|| {
         let robot = Robot::connect(&target.path, LinkOptions::default()).map_err(link_error)?;
-        let simulated = target.sim.is_some();
+        let simulated = target.simulated();
         let base =
             |name: &str| json!({ "command": name, "port": robot.path(), "simulated": simulated });
         match args.cmd {

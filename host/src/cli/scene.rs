@@ -1,5 +1,6 @@
-//! `pushbot scene …`: check a scene file in the shared format (`pushbot_sim::scene`) before
-//! handing it to a command, and list the built-in presets.
+//! `pushbot scene …`: check a scene file in the shared format (`pushbot_world::scene`) before
+//! handing it to a command, and list the built-in presets. `check` also says what the loader
+//! normalised (a clockwise outline stored counter-clockwise), as `note:` lines or `notes`.
 
 use clap::{Args, Subcommand};
 use serde_json::json;
@@ -28,17 +29,22 @@ pub struct CheckArgs {
 pub fn run(g: &Global, cmd: SceneCommand) -> CliResult {
     match cmd {
         SceneCommand::Check(a) => {
-            let s = pushbot_world::Scene::preset_or_file(&a.scene)
+            let (s, notes) = pushbot_world::Scene::preset_or_file_noted(&a.scene)
                 .map_err(|e| CliError::bad_input(e.to_string()))?;
+            let notes: Vec<String> = notes.iter().map(|n| n.to_string()).collect();
             let ids: Vec<&str> = s.objects.iter().map(|o| o.id.as_str()).collect();
             if g.json {
                 let v = json!({
                     "scene": a.scene, "name": s.name, "table": [s.table.width, s.table.height],
                     "obstacles": s.obstacles.len(), "objects": ids, "goals": s.goals.len(),
                     "positions": s.positions.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(),
+                    "notes": notes,
                 });
                 println!("{v}");
             } else {
+                for n in &notes {
+                    println!("note: {n}");
+                }
                 println!(
                     "{}: ok — `{}`, table {} × {} m, {} obstacles, objects [{}], {} goals, {} named positions",
                     a.scene,

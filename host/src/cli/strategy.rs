@@ -11,20 +11,15 @@ use pushbot_world::Scene;
 use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
-use crate::exec::collect::{CollectParams, CollectReport, bring_inside, collect};
+use crate::exec::collect::{CollectParams, bring_inside, collect};
 use crate::exec::deliver::{DeliveryParams, deliver_dipole, deliver_learned};
 use crate::exec::deliver_path::deliver_among_obstacles;
 use crate::exec::{LiveOptions, LiveRobot};
-use crate::experiments::delivery::collect_or_load;
-use crate::experiments::strategy_eval::{
-    Method, StartResult, TrialSetup, parse_starts, run_start, summarise,
-};
+use crate::experiments::trials::{Method, summarise};
 use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
-use crate::strategy::figures;
 use crate::strategy::regression::{KernelParams, PushStrategy};
-use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::Sample;
-use crate::strategy::store::{self, StrategyWriter};
+use crate::strategy::store;
 
 /// Settings shared by collection and evaluation.
 #[derive(Args, Debug, Clone)]
@@ -52,25 +47,7 @@ pub struct SimArgs {
 }
 
 impl SimArgs {
-    fn options(&self, seed: u64) -> Result<SimRobotOptions, CliError> {
-        let ok = |v: f64| v.is_finite() && v >= 0.0;
-        let boundary_inset = self.boundary_inset.unwrap_or(0.1);
-        if !ok(self.noise_mm) || !ok(self.noise_deg) || !ok(boundary_inset) {
-            return Err(CliError::bad_input(
-                "noise and boundary inset must be finite and not negative",
-            ));
-        }
-        Ok(SimRobotOptions {
-            seed,
-            position_noise: self.noise_mm * 1e-3,
-            heading_noise: self.noise_deg.to_radians(),
-            boundary_inset,
-            table_margin: self.table_margin,
-            ..SimRobotOptions::default()
-        })
-    }
-
-    fn kernel(&self) -> Result<KernelParams, CliError> {
+    pub(super) fn kernel(&self) -> Result<KernelParams, CliError> {
         if !(self.kernel_width.is_finite() && self.kernel_width > 0.0) || self.k == 0 {
             return Err(CliError::bad_input(
                 "the kernel width must be positive and k at least 1",
@@ -224,7 +201,7 @@ pub enum BenchCmd {
     },
 }
 
-fn progress_bar(global: &Global, len: u64) -> ProgressBar {
+pub(super) fn progress_bar(global: &Global, len: u64) -> ProgressBar {
     if global.json || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
@@ -237,7 +214,10 @@ fn progress_bar(global: &Global, len: u64) -> ProgressBar {
     pb
 }
 
-fn scene_for(object: &str, scene: Option<&str>) -> Result<(Scene, Option<String>), CliError> {
+pub(super) fn scene_for(
+    object: &str,
+    scene: Option<&str>,
+) -> Result<(Scene, Option<String>), CliError> {
     let (name, id) = match scene {
         Some(s) => (s.to_owned(), Some(object.to_owned())),
         None => (format!("lau-{object}"), None),
@@ -246,99 +226,8 @@ fn scene_for(object: &str, scene: Option<&str>) -> Result<(Scene, Option<String>
     Ok((scene, id))
 }
 
-/// Collect in the simulation into `writer`'s file, starting from `existing` samples.
-fn collect_in_sim(
-    global: &Global,
-    scene: Scene,
-    object: Option<&str>,
-    sim: &SimArgs,
-    params: &CollectParams,
-    existing: Vec<Sample>,
-    writer: Option<&mut StrategyWriter>,
-) -> Result<(PushStrategy, CollectReport), CliError> {
-    let mut io = SimRobot::new(scene, object, None, sim.options(global.seed)?)
-        .map_err(CliError::BadInput)?;
-    let mut strategy = PushStrategy::new(existing, sim.kernel()?);
-    let pb = progress_bar(global, params.initial as u64);
-    let mut w = writer;
-    let mut sink = |s: &Sample| -> anyhow::Result<()> {
-        if let Some(w) = w.as_deref_mut() {
-            w.append(s)?;
-        }
-        Ok(())
-    };
-    let rep = collect(&mut io, &mut strategy, params, &mut sink, &pb)?;
-    pb.finish_and_clear();
-    Ok((strategy, rep))
-}
-
-/// Run `pushbot collect`.
-pub fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
-    let (scene, id) = scene_for(&a.object, a.scene.as_deref())?;
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}.strategy", a.object)));
-    let (mut writer, existing) =
-        StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
-    let had = existing.len();
-    let params = CollectParams {
-        initial: a.initial,
-        streak: a.streak,
-        max_queries: a.max_queries,
-        seed: global.seed,
-        ..CollectParams::default()
-    };
-    let outline = object_outline(&scene, id.as_deref());
-    let (strategy, rep) = collect_in_sim(
-        global,
-        scene,
-        id.as_deref(),
-        &a.sim,
-        &params,
-        existing,
-        Some(&mut writer),
-    )?;
-    if let Some(svg) = &a.svg {
-        std::fs::write(svg, figures::strategy_svg(strategy.samples(), &outline))
-            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
-    }
-    if global.json {
-        println!(
-            "{}",
-            json!({"object": a.object, "file": out, "samples_before": had, "report": rep})
-        );
-    } else {
-        println!(
-            "{}: {} samples ({} initial, {} supplemental, {} before) in {:.1} simulated min \
-             ({:.1} initial); queries {} ok {}; {} straight successes {}",
-            a.object,
-            rep.total_samples,
-            rep.initial_samples,
-            rep.supplemental_samples,
-            had,
-            rep.total_minutes,
-            rep.initial_minutes,
-            rep.queries,
-            rep.successes,
-            a.streak,
-            if rep.streak_reached {
-                "reached"
-            } else {
-                "NOT reached"
-            },
-        );
-        println!("written to {}", out.display());
-    }
-    Ok(if rep.streak_reached || a.streak == 0 {
-        Status::Success
-    } else {
-        Status::TaskFailed
-    })
-}
-
 /// The object's outline relative to its marker (for figures).
-fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
+pub(super) fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
     let obj = match id {
         Some(id) => scene.object(id),
         None => scene.objects.first(),
@@ -353,66 +242,6 @@ fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
     .unwrap_or_default()
 }
 
-/// The six objects of Lau et al. (Fig. 6), as preset scenes, in the order of their Fig. 11.
-pub const LAU_SCENES: &[&str] = &[
-    "lau-irregular",
-    "lau-irregular-corner",
-    "lau-l-shape",
-    "lau-wire-cutter",
-    "lau-scissors",
-    "lau-snake",
-];
-
-/// One scene's evaluation.
-#[derive(Debug, serde::Serialize)]
-struct SceneEval {
-    scene: String,
-    samples: usize,
-    collection: Option<CollectReport>,
-    results: Vec<StartResult>,
-}
-
-/// The table of Lau et al. Fig. 11: success % per start (rows) and scene × method (columns).
-fn fig11_table(evals: &[SceneEval], starts: &[String], methods: &[Method]) -> String {
-    use std::fmt::Write;
-    let mut t = String::new();
-    let short = |s: &str| s.strip_prefix("lau-").unwrap_or(s).to_owned();
-    let name = |m: &Method| match m {
-        Method::Learned => "ours",
-        Method::Dipole => "dipole",
-    };
-    let _ = write!(t, "{:<6}", "start");
-    for e in evals {
-        let w = 9 * methods.len();
-        let _ = write!(t, "| {:<w$}", short(&e.scene));
-    }
-    t.push('\n');
-    let _ = write!(t, "{:<6}", "");
-    for _ in evals {
-        t.push_str("| ");
-        for m in methods {
-            let _ = write!(t, "{:<9}", name(m));
-        }
-    }
-    t.push('\n');
-    for s in starts {
-        let _ = write!(t, "{s:<6}");
-        for e in evals {
-            t.push_str("| ");
-            for m in methods {
-                let cell = e
-                    .results
-                    .iter()
-                    .find(|r| &r.start == s && r.method == *m)
-                    .map_or("-".to_owned(), |r| format!("{:.0}", r.success_rate));
-                let _ = write!(t, "{cell:<9}");
-            }
-        }
-        t.push('\n');
-    }
-    t
-}
-
 /// Run `pushbot eval`.
 pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     let EvalCmd::Delivery(a) = a.cmd;
@@ -424,173 +253,36 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
             Scene::preset_or_file(&a.scene).map_err(|e| CliError::bad_input(e.to_string()))?;
         return run_hil(global, &a, &scene);
     }
-    let starts = parse_starts(&a.start).map_err(CliError::bad_input)?;
-    let names: Vec<String> = if a.scene.trim() == "lau-all" {
-        LAU_SCENES.iter().map(|s| (*s).to_owned()).collect()
-    } else {
-        a.scene
-            .split(',')
-            .map(|s| s.trim().to_owned())
-            .filter(|s| !s.is_empty())
-            .collect()
-    };
-    if names.is_empty() {
-        return Err(CliError::bad_input("no scene given"));
-    }
-    if names.len() > 1 && a.strategy.is_some() {
-        return Err(CliError::bad_input(
-            "--strategy is one file for one scene; use --strategy-dir with several scenes",
-        ));
-    }
-    let mut scenes = Vec::new();
-    for n in &names {
-        let scene = Scene::preset_or_file(n).map_err(|e| CliError::bad_input(e.to_string()))?;
-        for s in &starts {
-            if scene.position(s).is_none() {
-                return Err(CliError::bad_input(format!(
-                    "scene {} has no start position {s}",
-                    scene.name
-                )));
-            }
-        }
-        scenes.push(scene);
-    }
-    let methods: Vec<Method> = match a.method {
-        MethodArg::Learned => vec![Method::Learned],
-        MethodArg::Dipole => vec![Method::Dipole],
-        MethodArg::Both => vec![Method::Dipole, Method::Learned],
-    };
-    let mut evals = Vec::new();
-    let mut trajectories = Vec::new();
-    for (name, scene) in names.iter().zip(&scenes) {
-        let setup = TrialSetup {
-            scene: scene.clone(),
-            object: a.object.clone(),
-            sim: a.sim.options(global.seed)?,
-            delivery: a.delivery_params()?,
-            kernel: a.sim.kernel()?,
-        };
-        setup.goal().map_err(CliError::BadInput)?;
-        // The strategy: from a file, from the cache directory (collected there when missing),
-        // or collected here first.
-        let params = CollectParams {
-            initial: a.initial,
-            streak: a.streak,
-            seed: global.seed,
-            ..CollectParams::default()
-        };
-        let mut collection = None;
-        let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
-            Vec::new()
-        } else if let Some(path) = &a.strategy {
-            store::load(path)
-                .map_err(|e| CliError::bad_input(e.to_string()))?
-                .samples
-        } else if let Some(dir) = &a.strategy_dir {
-            std::fs::create_dir_all(dir).map_err(|e| {
-                CliError::bad_input(format!("cannot create {}: {e}", dir.display()))
-            })?;
-            let file = dir.join(format!("{}.strategy", name.replace(['/', '.'], "_")));
-            let pb = progress_bar(global, params.initial as u64);
-            let (samples, rep) = collect_or_load(
-                scene,
-                a.object.as_deref(),
-                &file,
-                setup.sim,
-                &params,
-                setup.kernel,
-                &pb,
-            )
-            .map_err(CliError::Failed)?;
-            pb.finish_and_clear();
-            collection = rep;
-            samples
-        } else {
-            let mut clear = scene.clone();
-            clear.obstacles.clear();
-            let (strat, rep) = collect_in_sim(
-                global,
-                clear,
-                a.object.as_deref(),
-                &a.sim,
-                &params,
-                Vec::new(),
-                None,
-            )?;
-            collection = Some(rep);
-            strat.samples().to_vec()
-        };
-        let mut results: Vec<StartResult> = Vec::new();
-        for s in &starts {
-            for &m in &methods {
-                let (res, runs) = run_start(&setup, m, &samples, s, a.trials)?;
-                if let Some(first) = runs.into_iter().next()
-                    && names.len() == 1
-                {
-                    trajectories.push((format!("{s} {m:?}"), first.trajectory));
-                }
-                if !global.json {
-                    println!(
-                        "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?}",
-                        scene.name,
-                        res.start,
-                        format!("{m:?}"),
-                        res.success_rate,
-                        res.trials,
-                        res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
-                        res.mean_object_path_m
-                            .map_or("-".into(), |t| format!("{t:.2} m")),
-                        res.failures,
-                    );
-                }
-                results.push(res);
-            }
-        }
-        evals.push(SceneEval {
-            scene: scene.name.clone(),
-            samples: samples.len(),
-            collection,
-            results,
-        });
-    }
-    if let Some(svg) = &a.svg {
-        if let [scene] = scenes.as_slice() {
-            let goal = scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
-            let text = figures::trajectories_svg(&trajectories, scene, goal);
-            std::fs::write(svg, text)
-                .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
-        } else {
-            return Err(CliError::bad_input("--svg draws one scene's trajectories"));
-        }
-    }
-    let learned_ok = evals
-        .iter()
-        .flat_map(|e| &e.results)
-        .filter(|r| r.method == Method::Learned)
-        .all(|r| r.success_rate >= 95.0);
-    if global.json {
-        println!(
-            "{}",
-            json!({
-                "trials": a.trials,
-                "starts": starts,
-                "scenes": evals,
-            })
-        );
-    } else {
-        println!("\nSuccess % of {} trials (Lau et al. Fig. 11):", a.trials);
-        print!("{}", fig11_table(&evals, &starts, &methods));
-    }
-    Ok(if learned_ok {
-        Status::Success
-    } else {
-        Status::TaskFailed
-    })
+    eval_in_sim(global, a)
+}
+
+/// `pushbot eval delivery` in the in-process simulation.
+#[cfg(feature = "sim")]
+fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
+    super::strategy_sim::eval_in_sim(global, a)
+}
+
+/// Without the `sim` feature only `--hil` evaluates.
+#[cfg(not(feature = "sim"))]
+fn eval_in_sim(_global: &Global, _a: DeliveryArgs) -> CliResult {
+    Err(super::no_simulated_target())
+}
+
+/// Run `pushbot collect`.
+#[cfg(feature = "sim")]
+pub fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
+    super::strategy_sim::run_collect(global, a)
+}
+
+/// Without the `sim` feature there is nothing to collect in.
+#[cfg(not(feature = "sim"))]
+pub fn run_collect(_global: &Global, _a: CollectArgs) -> CliResult {
+    Err(super::no_simulated_target())
 }
 
 impl DeliveryArgs {
     /// The delivery parameters these arguments set (time limit, boundary guard).
-    fn delivery_params(&self) -> Result<DeliveryParams, CliError> {
+    pub(super) fn delivery_params(&self) -> Result<DeliveryParams, CliError> {
         let d = DeliveryParams::default();
         let boundary_guard = self.boundary_guard.unwrap_or(d.boundary_guard);
         if !(boundary_guard.is_finite() && boundary_guard >= 0.0) {

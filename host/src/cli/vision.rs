@@ -12,7 +12,7 @@ use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
 use crate::vision::source::{FrameSource, SourceError, open_source};
 use crate::vision::tracking::TrackerParams;
-use crate::vision::{Pipeline, RoiParams, TrackLine, bench};
+use crate::vision::{Pipeline, RoiParams, TrackLine};
 
 /// Where frames come from and what is on the table.
 #[derive(Args, Debug, Clone)]
@@ -227,11 +227,19 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     Ok(Status::Success)
 }
 
+/// `pushbot bench vision` needs the simulated camera's frames.
+#[cfg(not(feature = "sim"))]
+pub fn bench(_g: &Global, _cmd: BenchCommand) -> CliResult {
+    Err(super::no_simulated_target())
+}
+
 /// `pushbot bench vision`.
+#[cfg(feature = "sim")]
 pub fn bench(g: &Global, cmd: BenchCommand) -> CliResult {
     match cmd {
         BenchCommand::Vision { frames } => {
-            let r = bench::run(frames, g.seed).map_err(|e| CliError::Failed(anyhow::anyhow!(e)))?;
+            let r = crate::vision::bench::run(frames, g.seed)
+                .map_err(|e| CliError::Failed(anyhow::anyhow!(e)))?;
             if g.json {
                 println!(
                     "{}",

@@ -1,9 +1,17 @@
-//! Experiments: the papers' evaluations run as sweeps in the in-process simulation (feature
-//! `sim`), with their tables and figures; the CLI only parses their arguments and prints.
+//! Experiments: the papers' evaluations run as sweeps, with their tables and figures; the CLI
+//! only parses their arguments and prints. Those that run in the in-process simulation need the
+//! feature `sim`.
 //!
-//! - [`strategy_eval`]: delivery trials of the learned strategy and the dipole field from the
-//!   scene's start positions (Lau et al. §V, Fig. 11).
-//! - [`delivery`]: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
+//! - [`trials`]: statistics of delivery trials (Lau et al. §V, Fig. 11), for any robot.
+//! - `strategy_eval`: delivery trials of the learned strategy and the dipole field from the
+//!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
+//! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
+//! - `demo`: the demo's three stages, one per paper, into a report.
 
+#[cfg(feature = "sim")]
 pub mod delivery;
+#[cfg(feature = "sim")]
+pub mod demo;
+#[cfg(feature = "sim")]
 pub mod strategy_eval;
+pub mod trials;

@@ -2,51 +2,18 @@
 //! start position of a scene to its goal, with the learned strategy and the dipole-field
 //! baseline side by side, in the in-process simulation.
 
-use std::collections::BTreeMap;
-
 use anyhow::{Result, anyhow};
 use nalgebra::Vector2;
 use pushbot_world::Scene;
 
+pub use super::trials::{Method, StartResult, parse_starts, summarise};
+use crate::exec::collect::CollectReport;
 use crate::exec::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use crate::exec::deliver_path::deliver_among_obstacles;
 use crate::planner::global::{ObstacleParams, scene_obstacles};
 use crate::strategy::regression::{KernelParams, PushStrategy};
 use crate::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
-use crate::strategy::sample::Sample;
-
-/// A delivery method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Method {
-    /// Algorithm 2 with the learned pushing strategy.
-    Learned,
-    /// The dipole field of Igarashi et al.
-    Dipole,
-}
-
-/// The results of one method from one start position.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct StartResult {
-    /// Start position name (A–F).
-    pub start: String,
-    /// Method.
-    pub method: Method,
-    /// Trials run.
-    pub trials: usize,
-    /// Trials that reached the goal.
-    pub successes: usize,
-    /// Successes in percent.
-    pub success_rate: f64,
-    /// Mean time of the successful trials, s (simulated).
-    pub mean_time_s: Option<f64>,
-    /// Mean object path length of the successful trials, m.
-    pub mean_object_path_m: Option<f64>,
-    /// Mean robot path length of the successful trials, m.
-    pub mean_robot_path_m: Option<f64>,
-    /// Failures by reason.
-    pub failures: BTreeMap<String, usize>,
-}
+use crate::strategy::sample::{Pose2, Sample};
 
 /// Everything a batch of trials needs.
 #[derive(Debug, Clone)]
@@ -154,84 +121,92 @@ pub fn run_start(
     Ok((summarise(start, method, &runs), runs))
 }
 
-fn mean(xs: impl Iterator<Item = f64>) -> Option<f64> {
-    let v: Vec<f64> = xs.collect();
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+/// The six objects of Lau et al. (Fig. 6), as preset scenes, in the order of their Fig. 11.
+pub const LAU_SCENES: &[&str] = &[
+    "lau-irregular",
+    "lau-irregular-corner",
+    "lau-l-shape",
+    "lau-wire-cutter",
+    "lau-scissors",
+    "lau-snake",
+];
+
+/// One scene's evaluation.
+#[derive(Debug, serde::Serialize)]
+pub struct SceneEval {
+    /// The scene's name.
+    pub scene: String,
+    /// Samples of the strategy used.
+    pub samples: usize,
+    /// The collection's report, when it collected.
+    pub collection: Option<CollectReport>,
+    /// One result per start and method.
+    pub results: Vec<StartResult>,
 }
 
-/// Success rate, means over successful trials, failures by reason.
-pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult {
-    let ok: Vec<&Delivery> = runs.iter().filter(|d| d.success).collect();
-    let mut failures = BTreeMap::new();
-    for d in runs {
-        if let Some(f) = d.failure {
-            let name = serde_json::to_value(f)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_owned))
-                .unwrap_or_else(|| format!("{f:?}"));
-            *failures.entry(name).or_insert(0) += 1;
+/// The table of Lau et al. Fig. 11: success % per start (rows) and scene × method (columns).
+pub fn fig11_table(evals: &[SceneEval], starts: &[String], methods: &[Method]) -> String {
+    use std::fmt::Write;
+    let mut t = String::new();
+    let short = |s: &str| s.strip_prefix("lau-").unwrap_or(s).to_owned();
+    let name = |m: &Method| match m {
+        Method::Learned => "ours",
+        Method::Dipole => "dipole",
+    };
+    let _ = write!(t, "{:<6}", "start");
+    for e in evals {
+        let w = 9 * methods.len();
+        let _ = write!(t, "| {:<w$}", short(&e.scene));
+    }
+    t.push('\n');
+    let _ = write!(t, "{:<6}", "");
+    for _ in evals {
+        t.push_str("| ");
+        for m in methods {
+            let _ = write!(t, "{:<9}", name(m));
         }
     }
-    StartResult {
-        start: start.to_owned(),
-        method,
-        trials: runs.len(),
-        successes: ok.len(),
-        success_rate: if runs.is_empty() {
-            0.0
-        } else {
-            100.0 * ok.len() as f64 / runs.len() as f64
-        },
-        mean_time_s: mean(ok.iter().map(|d| d.time)),
-        mean_object_path_m: mean(ok.iter().map(|d| d.object_path)),
-        mean_robot_path_m: mean(ok.iter().map(|d| d.robot_path)),
-        failures,
-    }
-}
-
-/// Parse start positions: `A..F`, `A,C,E` or `B`.
-pub fn parse_starts(s: &str) -> Result<Vec<String>, String> {
-    let s = s.trim();
-    if let Some((a, b)) = s.split_once("..") {
-        let (a, b) = (a.trim(), b.trim());
-        let (Some(ca), Some(cb)) = (single_letter(a), single_letter(b)) else {
-            return Err(format!("a range of starts is like A..F, not {s:?}"));
-        };
-        if ca > cb {
-            return Err(format!("empty range of starts {s:?}"));
+    t.push('\n');
+    for s in starts {
+        let _ = write!(t, "{s:<6}");
+        for e in evals {
+            t.push_str("| ");
+            for m in methods {
+                let cell = e
+                    .results
+                    .iter()
+                    .find(|r| &r.start == s && r.method == *m)
+                    .map_or("-".to_owned(), |r| format!("{:.0}", r.success_rate));
+                let _ = write!(t, "{cell:<9}");
+            }
         }
-        return Ok((ca..=cb).map(|c| c.to_string()).collect());
+        t.push('\n');
     }
-    let v: Vec<String> = s
-        .split(',')
-        .map(|x| x.trim().to_owned())
-        .filter(|x| !x.is_empty())
-        .collect();
-    if v.is_empty() {
-        return Err("no start position given".into());
-    }
-    Ok(v)
+    t
 }
 
-fn single_letter(s: &str) -> Option<char> {
-    let mut it = s.chars();
-    match (it.next(), it.next()) {
-        (Some(c), None) if c.is_ascii_alphabetic() => Some(c.to_ascii_uppercase()),
-        _ => None,
+/// Trials of every method from every start of one scene (Lau et al. §V): the results, in the
+/// order start × method, each handed to `report` as it is done, and the first trial's
+/// trajectory of each (labelled "START METHOD") for the figure.
+pub fn evaluate_scene(
+    setup: &TrialSetup,
+    methods: &[Method],
+    samples: &[Sample],
+    starts: &[String],
+    trials: usize,
+    report: &mut dyn FnMut(&StartResult),
+) -> Result<(Vec<StartResult>, Vec<(String, Vec<(Pose2, Pose2)>)>)> {
+    let mut results = Vec::new();
+    let mut trajectories = Vec::new();
+    for s in starts {
+        for &m in methods {
+            let (res, runs) = run_start(setup, m, samples, s, trials)?;
+            if let Some(first) = runs.into_iter().next() {
+                trajectories.push((format!("{s} {m:?}"), first.trajectory));
+            }
+            report(&res);
+            results.push(res);
+        }
     }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn starts_parse() {
-        assert_eq!(parse_starts("A..C").unwrap(), ["A", "B", "C"]);
-        assert_eq!(parse_starts("a..b").unwrap(), ["A", "B"]);
-        assert_eq!(parse_starts("B, D").unwrap(), ["B", "D"]);
-        assert!(parse_starts("F..A").is_err());
-        assert!(parse_starts("AB..C").is_err());
-        assert!(parse_starts(" ").is_err());
-    }
+    Ok((results, trajectories))
 }

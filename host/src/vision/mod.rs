@@ -21,6 +21,7 @@
 //! interest, about 2 ms per frame on one core against 30 ms for the reference C settings.
 
 pub mod apriltag;
+#[cfg(feature = "sim")]
 pub mod bench;
 pub mod calibration;
 pub mod detect;

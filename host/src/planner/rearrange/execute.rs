@@ -131,6 +131,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_world
                 x: 0.0,
                 y: 0.0,
                 size: (0.7 * side).min(0.05),
+                z: 0.0,
             }),
         });
         if let Some(gp) = problem.goal_movables[i] {

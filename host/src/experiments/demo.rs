@@ -1,0 +1,450 @@
+//! The demo's pipeline (`pushbot demo`): the three papers' tasks run one after the other on a
+//! robot seen by a camera — the built-in simulated target or a real robot — each stage with a
+//! progress bar, into a report folder (`report.html`, `summary.json`, figures, `demo.log`):
+//!
+//! 1. **strategy** (Lau, Mitani & Igarashi): collect a pushing strategy for an irregular object
+//!    (or reuse the cached one), then deliver the object to its goal among obstacles;
+//! 2. **rearrange** (Ben-Shahar & Rivlin): plan an optimal rearrangement of two boxes (cost map
+//!    and restoration) and execute it, re-observing and snapping to the grid;
+//! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and execute
+//!    them open loop.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, anyhow};
+use indicatif::{ProgressBar, ProgressStyle};
+use pushbot_world::Scene;
+
+use crate::exec::record::{Recorder, TracePoint, TruthProbe};
+use crate::exec::{LiveOptions, LiveRobot};
+use crate::planner::rearrange::Problem as RearrangeProblem;
+use crate::report::{Report, StageReport, figure};
+use crate::sim::SimTarget;
+use crate::strategy::sample::Pose2;
+
+/// The stages, in the order they run.
+pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
+
+/// What the demo runs, checked by the caller (scenes loaded, stages known).
+#[derive(Debug, Clone)]
+pub struct DemoOptions {
+    /// Folder for the report (created; files in it are replaced).
+    pub out: PathBuf,
+    /// Stages to run, in order (names of [`STAGES`]).
+    pub stages: Vec<String>,
+    /// The strategy stage's scene.
+    pub strategy_scene: Scene,
+    /// The rearrangement case's name and its grid problem.
+    pub rearrange: (String, RearrangeProblem),
+    /// The stable stage's preset or file.
+    pub stable_name: String,
+    /// A real robot's serial port and camera; `None`: the built-in simulated target.
+    pub robot: Option<(String, String)>,
+    /// Simulated seconds per wall second of the built-in target.
+    pub speed: f64,
+    /// Seed of every random draw.
+    pub seed: u64,
+    /// Also render every figure as PNG.
+    pub png: bool,
+    /// Where collected pushing strategies are cached (default: OUT/cache).
+    pub cache: Option<PathBuf>,
+    /// Keep a live view in OUT/live/live.html.
+    pub view: bool,
+    /// No progress bars (`--json`).
+    pub quiet: bool,
+}
+
+/// Run the demo's stages into a report; a stage that fails is recorded as failed and the next
+/// one runs. Returns the report, written.
+pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
+    let report = Report::create(&opts.out, "pushbot demo", opts.png)?;
+    let log = std::fs::File::create(opts.out.join("demo.log"))
+        .map_err(|e| anyhow!("creating demo.log: {e}"))?;
+    let mut ctx = Ctx { opts, report, log };
+    for stage in &opts.stages {
+        let started = std::time::Instant::now();
+        let result = match stage.as_str() {
+            "strategy" => stage_strategy(&mut ctx, &opts.strategy_scene),
+            "rearrange" => stage_rearrange(&mut ctx, &opts.rearrange.0, &opts.rearrange.1),
+            _ => stage_stable(&mut ctx, &opts.stable_name),
+        };
+        let mut rep = match result {
+            Ok(r) => r,
+            Err(e) => {
+                let mut r = StageReport::new(stage, stage, "");
+                r.notes.push(format!("error: {e:#}"));
+                r
+            }
+        };
+        rep.wall_s = started.elapsed().as_secs_f64();
+        ctx.log(&format!(
+            "stage {stage}: {} in {:.1} s wall, {:.1} s mission time",
+            if rep.success { "reached" } else { "FAILED" },
+            rep.wall_s,
+            rep.mission_s
+        ));
+        for n in &rep.notes {
+            ctx.log(&format!("  {n}"));
+        }
+        ctx.report.add(rep);
+    }
+    let page = ctx.report.write()?;
+    Ok((ctx.report, page))
+}
+
+/// Everything a stage needs.
+struct Ctx<'a> {
+    opts: &'a DemoOptions,
+    report: Report,
+    log: std::fs::File,
+}
+
+impl Ctx<'_> {
+    fn log(&mut self, line: &str) {
+        let _ = writeln!(self.log, "{line}");
+        tracing::info!("{line}");
+    }
+
+    fn bar(&self, stage: &str) -> ProgressBar {
+        let pb = if self.opts.quiet {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new_spinner()
+        };
+        pb.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {prefix:10} {wide_msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        pb.set_prefix(stage.to_string());
+        pb.enable_steady_tick(std::time::Duration::from_millis(120));
+        pb
+    }
+
+    /// Run `f` on the robot: the built-in simulated target serving `scene`, or the real one.
+    fn with_robot<T>(
+        &mut self,
+        scene: &Scene,
+        object: Option<&str>,
+        ids: &[String],
+        f: impl FnOnce(&mut Recorder<'_>) -> Result<T>,
+    ) -> Result<(T, Vec<TracePoint>)> {
+        let speed = if self.opts.robot.is_some() {
+            1.0
+        } else {
+            self.opts.speed
+        };
+        let opts = LiveOptions {
+            object: object.map(str::to_owned),
+            watchdog_ms: (1000.0 * speed.max(1.0)).min(5000.0) as u16,
+            view_dir: self.opts.view.then(|| self.opts.out.join("live")),
+            ..LiveOptions::default()
+        };
+        match &self.opts.robot {
+            Some((port, camera)) => {
+                let mut live = LiveRobot::connect(port, camera, scene, opts)?;
+                let mut rec = Recorder::new(&mut live, ids, None);
+                let out = f(&mut rec)?;
+                Ok((out, rec.into_trace()))
+            }
+            None => {
+                let target = SimTarget::start(scene, self.opts.seed, speed, None)?;
+                self.log(&format!(
+                    "simulated target: serial {} camera {}",
+                    target.port(),
+                    target.camera()
+                ));
+                let result = {
+                    let mut live = LiveRobot::connect(target.port(), target.camera(), scene, opts)?;
+                    let probe: TruthProbe<'_> = Box::new(|| {
+                        let t = target.sim().truth().pose;
+                        let objects = target
+                            .sim()
+                            .objects()
+                            .into_iter()
+                            .map(|(id, p)| (id, Pose2::new(p.x, p.y, p.theta)))
+                            .collect();
+                        (Pose2::new(t.x, t.y, t.theta), objects)
+                    });
+                    let mut rec = Recorder::new(&mut live, ids, Some(probe));
+                    let out = f(&mut rec);
+                    out.map(|o| (o, rec.into_trace()))
+                };
+                target.shutdown()?;
+                result
+            }
+        }
+    }
+}
+
+/// Lau et al.: collect (or reuse) the strategy, deliver among obstacles through the link.
+fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
+    use crate::exec::collect::CollectParams;
+    use crate::exec::deliver::DeliveryParams;
+    use crate::exec::deliver_path::deliver_among_obstacles;
+    use crate::experiments::delivery::collect_or_load;
+    use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
+    use crate::strategy::figures::strategy_svg;
+    use crate::strategy::regression::{KernelParams, PushStrategy};
+    use crate::strategy::robot_io::SimRobotOptions;
+
+    let mut st = StageReport::new(
+        "strategy",
+        "Learned pushing strategy: deliver an irregular object among obstacles",
+        "Lau, Mitani & Igarashi §III-C–E (Algorithms 1, 2)",
+    );
+    let object = scene
+        .objects
+        .first()
+        .ok_or_else(|| anyhow!("scene {} has no object", scene.name))?
+        .clone();
+    let cache_dir = ctx
+        .opts
+        .cache
+        .clone()
+        .unwrap_or_else(|| ctx.opts.out.join("cache"));
+    std::fs::create_dir_all(&cache_dir)
+        .with_context(|| format!("creating {}", cache_dir.display()))?;
+    let cache = cache_dir.join(format!("{}-{}.strategy", scene.name, object.id));
+    let pb = ctx.bar("strategy");
+    pb.set_message(format!(
+        "pushing strategy for {} ({})",
+        object.id,
+        cache.display()
+    ));
+    let kernel = KernelParams::default();
+    let sim = SimRobotOptions {
+        seed: ctx.opts.seed,
+        ..SimRobotOptions::default()
+    };
+    let (samples, collection) = collect_or_load(
+        scene,
+        Some(&object.id),
+        &cache,
+        sim,
+        &CollectParams::default(),
+        kernel,
+        &pb,
+    )?;
+    st.number("samples", samples.len());
+    st.number("collected_now", collection.is_some());
+    if let Some(c) = &collection {
+        st.number("collection", serde_json::to_value(c)?);
+    }
+    let marker = object.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+    let outline: Vec<[f64; 2]> = object
+        .outline
+        .iter()
+        .map(|v| [v[0] - marker[0], v[1] - marker[1]])
+        .collect();
+    let f = ctx
+        .report
+        .figure("strategy-samples", &strategy_svg(&samples, &outline))?;
+    st.figures.push((
+        f,
+        format!(
+            "The pushing strategy of {} (Fig. 7): each sample's robot motion from where it pushed, and the object's motion",
+            object.id
+        ),
+    ));
+    pb.set_message("delivering through the serial port and the camera");
+    let goal = scene_goal(scene, Some(&object.id))?;
+    let obstacles = scene_obstacles(scene);
+    let ids = vec![object.id.clone()];
+    let (res, trace) = ctx.with_robot(scene, Some(&object.id), &ids, |io| {
+        let mut strategy = PushStrategy::new(samples.iter().copied(), kernel);
+        deliver_among_obstacles(
+            io,
+            &mut strategy,
+            goal,
+            &obstacles,
+            &DeliveryParams::default(),
+            &ObstacleParams::default(),
+            &mut |_| Ok(()),
+        )
+    })?;
+    pb.finish_and_clear();
+    let d = &res.delivery;
+    st.success = d.success;
+    st.mission_s = d.time;
+    st.number("steps", d.steps);
+    st.number("repositions", d.repositions);
+    st.number("subgoals", res.subgoals.len());
+    st.number("final_distance_m (camera)", d.final_distance);
+    if let Some(last) = trace.last().and_then(|p| p.truth.clone()) {
+        let m = scene_marker_truth(&object, &last.1);
+        if let Some(m) = m {
+            st.number(
+                "final_distance_m (truth)",
+                (m[0] - goal.x).hypot(m[1] - goal.y),
+            );
+        }
+    }
+    if let Some(why) = &d.failure {
+        st.notes.push(format!("delivery failed: {why:?}"));
+    }
+    st.notes.push(format!(
+        "{} samples ({}); delivered in {} pushes, {:.0} s of mission time",
+        samples.len(),
+        if collection.is_some() {
+            "collected now"
+        } else {
+            "from the cache"
+        },
+        d.steps,
+        d.time
+    ));
+    let f = ctx.report.figure(
+        "strategy-delivery",
+        &figure::run_svg(scene, &trace, "delivery among obstacles (truth)", true),
+    )?;
+    st.figures.push((
+        f,
+        "Delivery (Fig. 8): robot blue, object red, start dashed, goal green".into(),
+    ));
+    Ok(st)
+}
+
+/// Where the object's marker truly is, from its true body pose.
+fn scene_marker_truth(
+    object: &pushbot_world::scene::Object,
+    truth: &[(String, Pose2)],
+) -> Option<[f64; 2]> {
+    let (_, p) = truth.iter().find(|(id, _)| *id == object.id)?;
+    let m = object.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+    let (s, c) = p.theta.sin_cos();
+    Some([p.x + c * m[0] - s * m[1], p.y + s * m[0] + c * m[1]])
+}
+
+/// Ben-Shahar & Rivlin: cost map, restoration, execution through the link with snapping.
+fn stage_rearrange(
+    ctx: &mut Ctx<'_>,
+    case: &str,
+    problem: &crate::planner::rearrange::Problem,
+) -> Result<StageReport> {
+    use crate::planner::rearrange::execute::{ExecOptions, SceneOptions, execute, scene_for};
+    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg};
+
+    let mut st = StageReport::new(
+        "rearrange",
+        &format!("Optimal rearrangement of {case} by pushing"),
+        "Ben-Shahar & Rivlin §IV (cost map, restoration), §V",
+    );
+    let pb = ctx.bar("rearrange");
+    pb.set_message("cost map");
+    let model = Model::new(problem).map_err(|e| anyhow!("{e}"))?;
+    let map = cost_map(&model).map_err(|e| anyhow!("{e}"))?;
+    st.number("states_mapped", map.stats.states_mapped);
+    st.number("map_ms", map.stats.map_ms);
+    let start = model
+        .pack(&problem.start)
+        .ok_or_else(|| anyhow!("the start of {case} is not free"))?;
+    let plan = restore(&model, &map, start).map_err(|e| anyhow!("{e}"))?;
+    st.number("plan_cost", plan.cost);
+    st.number("plan_steps", plan.steps.len());
+    let f = ctx
+        .report
+        .figure("rearrange-plan", &plan_svg(&model, &plan))?;
+    st.figures
+        .push((f, format!("The optimal plan of {case}, step by step")));
+    let scene_opts = SceneOptions::default();
+    let scene = scene_for(problem, &scene_opts)?;
+    let ids: Vec<String> = scene.objects.iter().map(|o| o.id.clone()).collect();
+    pb.set_message("executing through the serial port and the camera");
+    let exec = ExecOptions {
+        cell: scene_opts.cell,
+        fill: scene_opts.fill,
+        ..ExecOptions::default()
+    };
+    let (rep, trace) = ctx.with_robot(&scene, None, &ids, |io| execute(&model, &map, io, &exec))?;
+    pb.finish_and_clear();
+    st.success = rep.reached;
+    st.mission_s = rep.time_s;
+    st.number("executed_cost", rep.executed_cost);
+    st.number("pushes", rep.pushes);
+    st.number("deviations_snapped", rep.deviations);
+    let f = ctx.report.figure(
+        "rearrange-run",
+        &figure::run_svg(&scene, &trace, "executed rearrangement (truth)", true),
+    )?;
+    st.figures.push((
+        f,
+        "Execution on the simulated target: robot blue, boxes red".into(),
+    ));
+    Ok(st)
+}
+
+/// Lynch & Mason: plan stable pushes for the plated robot, execute them open loop.
+fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
+    use crate::exec::stable::execute;
+    use crate::planner::stable::robot::{robot_problem, robot_start, sim_scene};
+    use crate::planner::stable::{plan, svg};
+
+    let mut st = StageReport::new(
+        "stable",
+        &format!("Stable pushing of the slider among obstacles ({name})"),
+        "Lynch & Mason §3 (STABLE), §4 (planner)",
+    );
+    let pb = ctx.bar("stable");
+    pb.set_message("planning stable pushes for the plated robot");
+    let (s, p) = robot_problem(name, None)?;
+    let pl = plan(&p);
+    st.number("found", pl.found);
+    st.number("plan_cost", pl.cost);
+    st.number("pushes_planned", pl.pushes);
+    st.number("nodes_expanded", pl.nodes_expanded);
+    st.number("plan_ms", pl.plan_time_ms);
+    let f = ctx
+        .report
+        .figure("stable-plan", &svg::render(&p, Some(&pl)))?;
+    st.figures
+        .push((f, "The plan over stable pushes (Fig. 13–18 style)".into()));
+    if !pl.found {
+        st.notes
+            .push("no plan of stable pushes exists for this robot".into());
+        return Ok(st);
+    }
+    let start = robot_start(&p, &pl).ok_or_else(|| anyhow!("the plan has no step"))?;
+    let scene = sim_scene(&s, &p, start, 1)?;
+    pb.set_message("pushing open loop through the serial port");
+    let ids = vec!["slider".to_string()];
+    let ((pushes, end), trace) =
+        ctx.with_robot(&scene, Some("slider"), &ids, |io| execute(&p, &pl, io))?;
+    pb.finish_and_clear();
+    let pushed: f64 = pushes.iter().map(|r| r.pushed).sum();
+    let worst = pushes
+        .iter()
+        .map(|r| r.drift / r.pushed.max(0.01))
+        .fold(0.0, f64::max);
+    let worst_angle = pushes.iter().map(|r| r.drift_angle).fold(0.0, f64::max);
+    st.success = p.in_goal(&end);
+    st.mission_s = trace.last().map_or(0.0, |t| t.t - trace[0].t);
+    st.number("pushed_m", pushed);
+    st.number("worst_drift_per_100mm_mm", worst * 100.0);
+    st.number("worst_drift_deg", worst_angle.to_degrees());
+    st.number("end_x", end.x);
+    st.number("end_y", end.y);
+    st.number("end_theta_deg", end.theta.to_degrees());
+    if !st.success {
+        st.notes.push(format!(
+            "the slider ended at ({:.3}, {:.3}, {:.1}°), outside the goal neighbourhood",
+            end.x,
+            end.y,
+            end.theta.to_degrees()
+        ));
+    }
+    let f = ctx.report.figure(
+        "stable-run",
+        &figure::run_svg(
+            &scene,
+            &trace,
+            "stable pushes executed open loop (truth)",
+            true,
+        ),
+    )?;
+    st.figures.push((
+        f,
+        "Open-loop execution: the slider stays on the plate".into(),
+    ));
+    Ok(st)
+}

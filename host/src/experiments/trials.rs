@@ -1,0 +1,122 @@
+//! Trials of a delivery method and their statistics, as Lau, Mitani & Igarashi report them (§V,
+//! Fig. 11): success rate, mean time and object path of the successful trials, failures by
+//! reason; and the start positions a command names (`A..F`).
+
+use std::collections::BTreeMap;
+
+use crate::exec::deliver::Delivery;
+
+/// A delivery method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Algorithm 2 with the learned pushing strategy.
+    Learned,
+    /// The dipole field of Igarashi et al.
+    Dipole,
+}
+
+/// The results of one method from one start position.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StartResult {
+    /// Start position name (A–F).
+    pub start: String,
+    /// Method.
+    pub method: Method,
+    /// Trials run.
+    pub trials: usize,
+    /// Trials that reached the goal.
+    pub successes: usize,
+    /// Successes in percent.
+    pub success_rate: f64,
+    /// Mean time of the successful trials, s (simulated).
+    pub mean_time_s: Option<f64>,
+    /// Mean object path length of the successful trials, m.
+    pub mean_object_path_m: Option<f64>,
+    /// Mean robot path length of the successful trials, m.
+    pub mean_robot_path_m: Option<f64>,
+    /// Failures by reason.
+    pub failures: BTreeMap<String, usize>,
+}
+
+fn mean(xs: impl Iterator<Item = f64>) -> Option<f64> {
+    let v: Vec<f64> = xs.collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+/// Success rate, means over successful trials, failures by reason.
+pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult {
+    let ok: Vec<&Delivery> = runs.iter().filter(|d| d.success).collect();
+    let mut failures = BTreeMap::new();
+    for d in runs {
+        if let Some(f) = d.failure {
+            let name = serde_json::to_value(f)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_owned))
+                .unwrap_or_else(|| format!("{f:?}"));
+            *failures.entry(name).or_insert(0) += 1;
+        }
+    }
+    StartResult {
+        start: start.to_owned(),
+        method,
+        trials: runs.len(),
+        successes: ok.len(),
+        success_rate: if runs.is_empty() {
+            0.0
+        } else {
+            100.0 * ok.len() as f64 / runs.len() as f64
+        },
+        mean_time_s: mean(ok.iter().map(|d| d.time)),
+        mean_object_path_m: mean(ok.iter().map(|d| d.object_path)),
+        mean_robot_path_m: mean(ok.iter().map(|d| d.robot_path)),
+        failures,
+    }
+}
+
+/// Parse start positions: `A..F`, `A,C,E` or `B`.
+pub fn parse_starts(s: &str) -> Result<Vec<String>, String> {
+    let s = s.trim();
+    if let Some((a, b)) = s.split_once("..") {
+        let (a, b) = (a.trim(), b.trim());
+        let (Some(ca), Some(cb)) = (single_letter(a), single_letter(b)) else {
+            return Err(format!("a range of starts is like A..F, not {s:?}"));
+        };
+        if ca > cb {
+            return Err(format!("empty range of starts {s:?}"));
+        }
+        return Ok((ca..=cb).map(|c| c.to_string()).collect());
+    }
+    let v: Vec<String> = s
+        .split(',')
+        .map(|x| x.trim().to_owned())
+        .filter(|x| !x.is_empty())
+        .collect();
+    if v.is_empty() {
+        return Err("no start position given".into());
+    }
+    Ok(v)
+}
+
+fn single_letter(s: &str) -> Option<char> {
+    let mut it = s.chars();
+    match (it.next(), it.next()) {
+        (Some(c), None) if c.is_ascii_alphabetic() => Some(c.to_ascii_uppercase()),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn starts_parse() {
+        assert_eq!(parse_starts("A..C").unwrap(), ["A", "B", "C"]);
+        assert_eq!(parse_starts("a..b").unwrap(), ["A", "B"]);
+        assert_eq!(parse_starts("B, D").unwrap(), ["B", "D"]);
+        assert!(parse_starts("F..A").is_err());
+        assert!(parse_starts("AB..C").is_err());
+        assert!(parse_starts(" ").is_err());
+    }
+}
