@@ -21,6 +21,7 @@ pub mod pushing;
 pub mod quasistatic;
 pub mod robot;
 pub mod sim;
+pub mod truth;
 pub mod world;
 
 pub use pty::{Pty, PtySim};

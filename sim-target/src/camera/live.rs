@@ -15,7 +15,7 @@ use super::scene_view::SceneCamera;
 use super::server::CameraServer;
 use crate::robot::Pose;
 use crate::scene::Scene;
-use crate::sim::Truth;
+use crate::truth::Truth;
 
 /// Most frames per second of wall time.
 const MAX_WALL_FPS: f64 = 30.0;
