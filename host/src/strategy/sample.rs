@@ -4,52 +4,10 @@
 //! robot's displacement (r), the object's displacement (s), all in the object's frame at the
 //! start of the push, and the object's change of heading θ.
 
-use nalgebra::{Rotation2, Vector2};
 
-/// A planar pose in table coordinates: metres and radians.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Pose2 {
-    /// x, m.
-    pub x: f64,
-    /// y, m.
-    pub y: f64,
-    /// Heading, rad.
-    pub theta: f64,
-}
-
-impl Pose2 {
-    /// A pose.
-    pub const fn new(x: f64, y: f64, theta: f64) -> Self {
-        Pose2 { x, y, theta }
-    }
-    /// Position as a vector.
-    pub fn position(&self) -> Vector2<f64> {
-        Vector2::new(self.x, self.y)
-    }
-    /// A table-frame vector expressed in this pose's frame (rotation only).
-    pub fn vector_to_local(&self, v: Vector2<f64>) -> Vector2<f64> {
-        Rotation2::new(-self.theta) * v
-    }
-    /// A vector of this pose's frame expressed in the table frame (rotation only).
-    pub fn vector_to_world(&self, v: Vector2<f64>) -> Vector2<f64> {
-        Rotation2::new(self.theta) * v
-    }
-    /// A table-frame point expressed in this pose's frame.
-    pub fn point_to_local(&self, p: Vector2<f64>) -> Vector2<f64> {
-        self.vector_to_local(p - self.position())
-    }
-    /// A point of this pose's frame expressed in the table frame.
-    pub fn point_to_world(&self, p: Vector2<f64>) -> Vector2<f64> {
-        self.vector_to_world(p) + self.position()
-    }
-}
-
-/// Wrap an angle to (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let r = a.rem_euclid(TAU);
-    if r > PI { r - TAU } else { r }
-}
+/// A planar pose in table coordinates: the world crate's one pose.
+pub use pushbot_world::Pose as Pose2;
+pub use pushbot_world::wrap_angle;
 
 /// One push: the paper's (p_x, p_y, r_x, r_y, s_x, s_y, θ), metres and radians, object frame.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -9,53 +9,7 @@ use std::path::Path;
 use pushbot_world::camera::{MarkerFamily, MarkerPlacement};
 use serde::{Deserialize, Serialize};
 
-/// A planar pose on the table: metres and radians (CCW from the table's +x).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct Pose {
-    /// x, metres.
-    pub x: f64,
-    /// y, metres.
-    pub y: f64,
-    /// Heading, radians in (−π, π].
-    pub theta: f64,
-}
-
-impl Pose {
-    /// A pose.
-    pub fn new(x: f64, y: f64, theta: f64) -> Pose {
-        Pose { x, y, theta }
-    }
-
-    /// `self ∘ local`: the pose `local` (given in this pose's frame) in the outer frame.
-    pub fn compose(&self, local: &Pose) -> Pose {
-        let (s, c) = self.theta.sin_cos();
-        Pose {
-            x: self.x + c * local.x - s * local.y,
-            y: self.y + s * local.x + c * local.y,
-            theta: wrap_angle(self.theta + local.theta),
-        }
-    }
-
-    /// The inverse transform.
-    pub fn inverse(&self) -> Pose {
-        let (s, c) = self.theta.sin_cos();
-        Pose {
-            x: -(c * self.x + s * self.y),
-            y: s * self.x - c * self.y,
-            theta: wrap_angle(-self.theta),
-        }
-    }
-}
-
-/// An angle mapped into (−π, π].
-pub fn wrap_angle(a: f64) -> f64 {
-    let t = a.rem_euclid(std::f64::consts::TAU);
-    if t > std::f64::consts::PI {
-        t - std::f64::consts::TAU
-    } else {
-        t
-    }
-}
+pub use pushbot_world::{Pose, wrap_angle};
 
 /// A marker fixed on the table at a known place: used to calibrate the camera.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
