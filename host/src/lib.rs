@@ -11,5 +11,7 @@ pub mod mechanics;
 pub mod planner;
 pub mod plot;
 pub mod report;
+pub mod robot;
+pub mod sim;
 pub mod strategy;
 pub mod vision;

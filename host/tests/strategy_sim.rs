@@ -7,7 +7,8 @@ use pushbot::strategy::collect::{CollectParams, collect, reset_robot_obj_boundar
 use pushbot::strategy::deliver::{DeliveryParams, deliver_learned};
 use pushbot::strategy::eval::{Method, TrialSetup, run_start};
 use pushbot::strategy::regression::{KernelParams, PushStrategy};
-use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
+use pushbot::sim::robot::{SimRobot, SimRobotOptions};
+use pushbot::strategy::robot_io::RobotIo;
 use pushbot::strategy::sample::Sample;
 use pushbot::strategy::store::{StrategyWriter, load};
 use pushbot_sim::{Pose, Scene};

@@ -293,7 +293,7 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
         ObstacleParams, collect_or_load, deliver_among_obstacles, scene_goal, scene_obstacles,
     };
     use crate::strategy::regression::{KernelParams, PushStrategy};
-    use crate::strategy::robot_io::SimRobotOptions;
+    use crate::sim::robot::SimRobotOptions;
 
     let mut st = StageReport::new(
         "strategy",

@@ -18,7 +18,7 @@ use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_s
 use crate::strategy::figures;
 use crate::strategy::obstacles;
 use crate::strategy::regression::{KernelParams, PushStrategy};
-use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::Sample;
 use crate::strategy::store::{self, StrategyWriter};
 

@@ -11,7 +11,8 @@ use pushbot_sim::Scene;
 use super::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use super::obstacles::{ObstacleParams, deliver_among_obstacles, scene_obstacles};
 use super::regression::{KernelParams, PushStrategy};
-use super::robot_io::{RobotIo, SimRobot, SimRobotOptions};
+use super::robot_io::RobotIo;
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 use super::sample::Sample;
 
 /// A delivery method.

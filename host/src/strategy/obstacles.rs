@@ -26,7 +26,8 @@ use pushbot_sim::Scene;
 use super::collect::{CollectParams, CollectReport, collect};
 use super::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};
 use super::regression::{KernelParams, PushStrategy};
-use super::robot_io::{RobotIo, SimRobot, SimRobotOptions, Workspace};
+use super::robot_io::{RobotIo, Workspace};
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 use super::sample::{Pose2, Sample};
 use super::store::{self, StrategyWriter};
 
