@@ -1,7 +1,7 @@
 //! Hardware-in-the-loop tests live in `tests/`: the real host link ([`pushbot::link`],
-//! [`pushbot::robot`]) against
-//! the simulated robot ([`pushbot_sim::PtySim`]) over a real pseudo-terminal, judged by the
-//! simulator's ground truth. This library holds their shared set-up.
+//! [`pushbot::robot`]) against the simulated robot ([`pushbot_sim::PtySim`]) over a real
+//! pseudo-terminal, judged by the simulator's ground truth. This library holds their shared
+//! set-up.
 
 use std::time::{Duration, Instant};
 
