@@ -3,11 +3,11 @@
 
 use indicatif::ProgressBar;
 use nalgebra::Vector2;
+use pushbot::sim::robot::{SimRobot, SimRobotOptions};
 use pushbot::strategy::collect::{CollectParams, collect, reset_robot_obj_boundary, safe_spin};
 use pushbot::strategy::deliver::{DeliveryParams, deliver_learned};
 use pushbot::strategy::eval::{Method, TrialSetup, run_start};
 use pushbot::strategy::regression::{KernelParams, PushStrategy};
-use pushbot::sim::robot::{SimRobot, SimRobotOptions};
 use pushbot::strategy::robot_io::RobotIo;
 use pushbot::strategy::sample::Sample;
 use pushbot::strategy::store::{StrategyWriter, load};

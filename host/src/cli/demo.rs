@@ -286,6 +286,7 @@ pub fn run(g: &Global, args: DemoArgs) -> CliResult {
 
 /// Lau et al.: collect (or reuse) the strategy, deliver among obstacles through the link.
 fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
+    use crate::sim::robot::SimRobotOptions;
     use crate::strategy::collect::CollectParams;
     use crate::strategy::deliver::DeliveryParams;
     use crate::strategy::figures::strategy_svg;
@@ -293,7 +294,6 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
         ObstacleParams, collect_or_load, deliver_among_obstacles, scene_goal, scene_obstacles,
     };
     use crate::strategy::regression::{KernelParams, PushStrategy};
-    use crate::sim::robot::SimRobotOptions;
 
     let mut st = StageReport::new(
         "strategy",

@@ -12,13 +12,13 @@ use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::{LiveOptions, LiveRobot};
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::collect::{CollectParams, CollectReport, bring_inside, collect};
 use crate::strategy::deliver::{DeliveryParams, deliver_dipole, deliver_learned};
 use crate::strategy::eval::{Method, StartResult, TrialSetup, parse_starts, run_start, summarise};
 use crate::strategy::figures;
 use crate::strategy::obstacles;
 use crate::strategy::regression::{KernelParams, PushStrategy};
-use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::Sample;
 use crate::strategy::store::{self, StrategyWriter};
 

@@ -165,7 +165,11 @@ fn lost_answers_are_resent_with_the_same_seq_then_given_up() {
     let mut c = Client::new(ms(0), opts());
     let seq = c.command(ms(0), Command::Stop);
     assert_eq!(sent(&mut c, ms(0)).1.len(), 1);
-    assert_eq!(c.poll_timeout(), Some(ms(50)), "the heartbeat fallback comes first");
+    assert_eq!(
+        c.poll_timeout(),
+        Some(ms(50)),
+        "the heartbeat fallback comes first"
+    );
     // Not yet: 149 ms.
     c.pause_heartbeats(true);
     assert_eq!(c.poll_timeout(), Some(ms(150)));
@@ -175,7 +179,14 @@ fn lost_answers_are_resent_with_the_same_seq_then_given_up() {
     for attempt in 2..=5 {
         c.handle_timeout(ms(now));
         let (_, frames) = sent(&mut c, ms(now));
-        assert_eq!(frames, [HostFrame { seq, cmd: Command::Stop }], "attempt {attempt}");
+        assert_eq!(
+            frames,
+            [HostFrame {
+                seq,
+                cmd: Command::Stop
+            }],
+            "attempt {attempt}"
+        );
         assert_eq!(c.take_answer(seq), None);
         now += 150;
     }
@@ -217,7 +228,10 @@ fn the_firmware_answers_a_retry_again_and_executes_it_once() {
 fn duplicate_and_late_replies_are_ignored() {
     let mut c = Client::new(ms(0), opts());
     let a = c.command(ms(0), Command::Stop);
-    c.handle_bytes(ms(1), &wire(&[RobotMsg::Ack { seq: a }, RobotMsg::Ack { seq: a }]));
+    c.handle_bytes(
+        ms(1),
+        &wire(&[RobotMsg::Ack { seq: a }, RobotMsg::Ack { seq: a }]),
+    );
     assert_eq!(c.take_answer(a), Some(Answer::Ack { at_us: None }));
     let b = c.command(ms(2), Command::ClearFaults);
     // A late duplicate of `a`'s answer, and a Nack for `a`, are not `b`'s.
@@ -259,10 +273,7 @@ fn out_of_order_replies_are_matched_by_seq() {
         ]),
     );
     assert_eq!(c.take_answer(b), Some(Answer::Ack { at_us: None }));
-    assert_eq!(
-        c.take_answer(a),
-        Some(Answer::Nack(NackReason::NoSession))
-    );
+    assert_eq!(c.take_answer(a), Some(Answer::Nack(NackReason::NoSession)));
     // Neither is resent.
     c.handle_timeout(ms(1000));
     assert!(
@@ -393,7 +404,10 @@ fn heartbeats_are_paced_by_robot_time() {
     c.set_watchdog_ms(1000);
     let mut n = 0;
     for k in 60..120u64 {
-        c.handle_bytes(ms(k), &wire(&[telemetry(1_000_000 + k * 20_000, None, None)]));
+        c.handle_bytes(
+            ms(k),
+            &wire(&[telemetry(1_000_000 + k * 20_000, None, None)]),
+        );
         n += sent(&mut c, ms(k)).1.len();
     }
     // The last one went at k = 57; then every 13th telemetry (260 ms): k = 70, 83, 96, 109.
@@ -401,7 +415,10 @@ fn heartbeats_are_paced_by_robot_time() {
     // Paused: none at all.
     c.pause_heartbeats(true);
     for k in 120..200u64 {
-        c.handle_bytes(ms(k), &wire(&[telemetry(1_000_000 + k * 20_000, None, None)]));
+        c.handle_bytes(
+            ms(k),
+            &wire(&[telemetry(1_000_000 + k * 20_000, None, None)]),
+        );
         c.handle_timeout(ms(k));
     }
     assert!(sent(&mut c, ms(200)).1.is_empty());
@@ -415,7 +432,13 @@ fn without_telemetry_heartbeats_fall_back_to_host_time() {
     assert!(sent(&mut c, ms(49)).1.is_empty());
     c.handle_timeout(ms(50));
     let frames = sent(&mut c, ms(50)).1;
-    assert_eq!(frames, [HostFrame { seq: 0, cmd: Command::Heartbeat }]);
+    assert_eq!(
+        frames,
+        [HostFrame {
+            seq: 0,
+            cmd: Command::Heartbeat
+        }]
+    );
     assert_eq!(c.poll_timeout(), Some(ms(100)));
 }
 

@@ -50,14 +50,12 @@ impl Reader {
             Ok(msg) => Some(Incoming::Msg(msg)),
             Err(error) => {
                 // CRC good but not a message of ours: another protocol version?
-                let foreign_hello = if matches!(
-                    error,
-                    DecodeError::Message | DecodeError::TrailingBytes
-                ) {
-                    frame_payload(&frame).and_then(|p| peek_hello_version(&p))
-                } else {
-                    None
-                };
+                let foreign_hello =
+                    if matches!(error, DecodeError::Message | DecodeError::TrailingBytes) {
+                        frame_payload(&frame).and_then(|p| peek_hello_version(&p))
+                    } else {
+                        None
+                    };
                 Some(Incoming::Rejected {
                     error,
                     foreign_hello,

@@ -28,8 +28,8 @@ use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use pushbot_protocol::{
-    Command, ConfigUpdate, ContactEvent, Faults, FirmwareVersion, Geometry, HelloReply, Mode,
-    Pose, Telemetry,
+    Command, ConfigUpdate, ContactEvent, Faults, FirmwareVersion, Geometry, HelloReply, Mode, Pose,
+    Telemetry,
 };
 
 use crate::link::{
@@ -190,8 +190,7 @@ impl<D: Driver> Robot<D> {
                     outcome: done.outcome,
                     pose: done.pose,
                     time_us: done.time_us,
-                    duration_s: start
-                        .map_or(0.0, |s| done.time_us.saturating_sub(s) as f64 / 1e6),
+                    duration_s: start.map_or(0.0, |s| done.time_us.saturating_sub(s) as f64 / 1e6),
                     recovered,
                 })
             }

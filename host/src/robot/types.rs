@@ -3,7 +3,9 @@
 
 use std::time::Duration;
 
-use pushbot_protocol::{Command, FirmwareVersion, Geometry, Outcome, PROTOCOL_VERSION, Pose, Telemetry};
+use pushbot_protocol::{
+    Command, FirmwareVersion, Geometry, Outcome, PROTOCOL_VERSION, Pose, Telemetry,
+};
 
 use crate::link::ClientOptions;
 

@@ -366,11 +366,7 @@ mod tests {
         r.spin(std::f64::consts::FRAC_PI_2).unwrap();
         r.forward(0.1).unwrap();
         let b = r.robot_pose();
-        assert!(
-            (wrap_angle(b.theta - a.theta) - std::f64::consts::FRAC_PI_2)
-                .abs()
-                < 0.05
-        );
+        assert!((wrap_angle(b.theta - a.theta) - std::f64::consts::FRAC_PI_2).abs() < 0.05);
         assert!(
             (b.y - a.y - 0.1).abs() < 0.01 && (b.x - a.x).abs() < 0.01,
             "{a:?} {b:?}"

@@ -12,8 +12,8 @@ use super::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use super::obstacles::{ObstacleParams, deliver_among_obstacles, scene_obstacles};
 use super::regression::{KernelParams, PushStrategy};
 use super::robot_io::RobotIo;
-use crate::sim::robot::{SimRobot, SimRobotOptions};
 use super::sample::Sample;
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 
 /// A delivery method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

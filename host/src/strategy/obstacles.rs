@@ -27,9 +27,9 @@ use super::collect::{CollectParams, CollectReport, collect};
 use super::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};
 use super::regression::{KernelParams, PushStrategy};
 use super::robot_io::{RobotIo, Workspace};
-use crate::sim::robot::{SimRobot, SimRobotOptions};
 use super::sample::{Pose2, Sample};
 use super::store::{self, StrategyWriter};
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 
 /// Parameters of the global path and its sub-goals.
 #[derive(Debug, Clone, Copy, PartialEq)]
