@@ -18,7 +18,6 @@ pub mod driver;
 mod error;
 pub mod serial;
 pub mod transport;
-mod wire;
 
 #[cfg(test)]
 mod client_tests;

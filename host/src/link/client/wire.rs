@@ -1,4 +1,4 @@
-//! The host's framing of the link, used only by the client ([`super::client`]): encode a
+//! The host's framing of the link, used only by the client ([`super`]): encode a
 //! [`HostFrame`], and read [`RobotMsg`]s from a byte stream, recognising a `HelloReply` of
 //! another protocol version by the fields every version keeps in place.
 
