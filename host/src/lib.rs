@@ -12,6 +12,7 @@ pub mod mechanics;
 pub mod planner;
 pub mod plot;
 pub mod report;
+pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod strategy;

@@ -9,7 +9,8 @@ use pushbot::planner::rearrange::execute::{
     ExecOptions, ExecReport, GridFrame, SceneOptions, execute, scene_for,
 };
 use pushbot::planner::rearrange::{CostMap, Model, Problem, cases::load_scene, cost_map};
-use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions, Workspace};
+use pushbot::sim::robot::{SimRobot, SimRobotOptions};
+use pushbot::strategy::robot_io::{RobotIo, Workspace};
 use pushbot::strategy::sample::Pose2;
 
 fn setup(case: &str, noise: bool, seed: u64) -> (Problem, Model, CostMap, SimRobot) {

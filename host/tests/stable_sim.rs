@@ -18,7 +18,8 @@ use pushbot::planner::stable::robot::{
     SPEED, robot_in_slider, robot_problem, robot_problem_edges, robot_start, sim_scene,
 };
 use pushbot::planner::stable::{Plan, Pose, Problem, angle_diff, plan};
-use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
+use pushbot::sim::robot::{SimRobot, SimRobotOptions};
+use pushbot::strategy::robot_io::RobotIo;
 
 /// The preset `name` for the plated robot (edge 0 only) with the goal heading tolerance of
 /// `goal_theta_deg`.

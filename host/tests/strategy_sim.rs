@@ -7,7 +7,7 @@ use pushbot::exec::collect::{CollectParams, collect, reset_robot_obj_boundary, s
 use pushbot::exec::deliver::{DeliveryParams, deliver_learned};
 use pushbot::experiments::strategy_eval::{Method, TrialSetup, run_start};
 use pushbot::strategy::regression::{KernelParams, PushStrategy};
-use pushbot::strategy::robot_io::{RobotIo, SimRobot, SimRobotOptions};
+use pushbot::strategy::robot_io::RobotIo;
 use pushbot::strategy::sample::Sample;
 use pushbot::strategy::store::{StrategyWriter, load};
 use pushbot_sim::{Pose, Scene};

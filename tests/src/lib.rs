@@ -1,10 +1,11 @@
-//! Hardware-in-the-loop tests live in `tests/`: the real host link ([`pushbot::link`]) against
-//! the simulated robot ([`pushbot_sim::PtySim`]) over a real pseudo-terminal, judged by the
-//! simulator's ground truth. This library holds their shared set-up.
+//! Hardware-in-the-loop tests live in `tests/`: the real host link ([`pushbot::link`],
+//! [`pushbot::robot`]) against the simulated robot ([`pushbot_sim::PtySim`]) over a real
+//! pseudo-terminal, judged by the simulator's ground truth. This library holds their shared
+//! set-up.
 
 use std::time::{Duration, Instant};
 
-use pushbot::link::{LinkOptions, Robot};
+use pushbot::robot::{LinkOptions, Robot};
 use pushbot_sim::{PtySim, SimOptions, Truth};
 
 /// Pace of the simulated robot in the HIL tests: five times real time, so the host's

@@ -6,7 +6,7 @@
 use std::f64::consts::FRAC_PI_2;
 use std::time::Duration;
 
-use pushbot::link::{LinkOptions, Robot};
+use pushbot::robot::{LinkOptions, Robot};
 use pushbot_protocol::Outcome;
 use pushbot_sim::faults::LinkFaults;
 use pushbot_sim::{Pose, PtySim, SimOptions};

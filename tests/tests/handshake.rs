@@ -1,6 +1,7 @@
 //! HIL: the handshake against the simulated robot, and a protocol-version mismatch refused.
 
-use pushbot::link::{LinkError, LinkOptions, Robot};
+use pushbot::link::LinkError;
+use pushbot::robot::{LinkOptions, Robot};
 use pushbot_protocol::{Faults, Mode, PROTOCOL_VERSION};
 use pushbot_tests::{connect, sim_at};
 

@@ -22,7 +22,8 @@ use std::sync::mpsc;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use pushbot::link::{LinkError, LinkOptions, Robot};
+use pushbot::link::LinkError;
+use pushbot::robot::{LinkOptions, Robot};
 use pushbot_firmware::RobotParams;
 use pushbot_protocol::{
     Command as Cmd, ConfigUpdate, Faults, HostFrame, MAX_FRAME, Mode, NackReason, Outcome,

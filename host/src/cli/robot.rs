@@ -6,7 +6,8 @@ use pushbot_protocol::{Faults, Mode, Outcome, Pose, Telemetry};
 use serde_json::{Value, json};
 
 use super::{CliError, CliResult, Global, Status};
-use crate::link::{DoneReport, FaultNames, LinkError, LinkOptions, Robot};
+use crate::link::{FaultNames, LinkError};
+use crate::robot::{DoneReport, LinkOptions, Robot};
 
 /// `pushbot robot`: the robot's commands and how to reach it.
 #[derive(Args, Debug)]

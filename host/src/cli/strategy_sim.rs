@@ -18,9 +18,9 @@ use crate::experiments::strategy_eval::{
     parse_starts,
 };
 use crate::planner::global::scene_goal;
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::figures;
 use crate::strategy::regression::PushStrategy;
-use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::Sample;
 use crate::strategy::store::{self, StrategyWriter};
 

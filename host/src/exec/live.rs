@@ -1,7 +1,7 @@
 //! The robot on the table as the strategy and the planners see it
 //! ([`RobotIo`]), over a real serial link and a real overhead camera.
 //!
-//! Every primitive is a firmware command sent through [`crate::link::Robot`] and waited for to
+//! Every primitive is a firmware command sent through [`crate::robot::Robot`] and waited for to
 //! its `Done`; every pose is what the camera shows *after* the primitive ended: fresh frames
 //! through marker detection, the calibration homography and the Kalman tracker
 //! ([`crate::vision::Pipeline`]). The host acts in steps (observe → decide → primitive → observe,
@@ -17,7 +17,7 @@ use pushbot_protocol::Outcome;
 use pushbot_world::Scene;
 
 use super::grabber::FrameGrabber;
-use crate::link::{LinkOptions, Robot};
+use crate::robot::{LinkOptions, Robot};
 use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
 use crate::strategy::sample::Pose2;
 use crate::vision::Pipeline;

@@ -150,7 +150,7 @@ impl RobotIo for Recorder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
+    use crate::sim::robot::{SimRobot, SimRobotOptions};
 
     #[test]
     fn records_a_point_after_every_primitive() {

@@ -13,8 +13,8 @@ use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::exec::deliver::DeliveryParams;
 use crate::exec::deliver_path::{ObstacleDelivery, deliver_among_obstacles};
 use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
+use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::regression::{KernelParams, PushStrategy};
-use crate::strategy::robot_io::{SimRobot, SimRobotOptions};
 use crate::strategy::sample::{Pose2, Sample};
 use crate::strategy::store::{self, StrategyWriter};
 

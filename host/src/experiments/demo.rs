@@ -184,9 +184,9 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
     use crate::exec::deliver_path::deliver_among_obstacles;
     use crate::experiments::delivery::collect_or_load;
     use crate::planner::global::{ObstacleParams, scene_goal, scene_obstacles};
+    use crate::sim::robot::SimRobotOptions;
     use crate::strategy::figures::strategy_svg;
     use crate::strategy::regression::{KernelParams, PushStrategy};
-    use crate::strategy::robot_io::SimRobotOptions;
 
     let mut st = StageReport::new(
         "strategy",

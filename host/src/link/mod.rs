@@ -1,24 +1,30 @@
-//! The host end of the serial link to the robot: transport, framing, handshake, heartbeats,
-//! acknowledged and retried commands, `Done`s, telemetry, reconnect, and a typed robot API.
+//! The host end of the serial link to the robot: the sans-IO link client (framing, handshake,
+//! sequence numbers, retries, replies, heartbeats, timeouts) and its serial driver (transport,
+//! a reader thread). The typed robot API over it is [`crate::robot`].
 //!
 //! ```no_run
-//! use pushbot::link::{LinkOptions, Robot};
-//! let robot = Robot::connect("/dev/ttyACM0", LinkOptions::default())?;
-//! let done = robot.move_distance(0.3, 0.1, false)?;
-//! println!("{:?} at {:?}", done.outcome, done.pose);
-//! # Ok::<(), pushbot::link::LinkError>(())
+//! use pushbot::link::{Client, ClientOptions, HostTime};
+//! use pushbot_protocol::Command;
+//! let mut client = Client::new(HostTime::default(), ClientOptions::default());
+//! let seq = client.command(HostTime::default(), Command::Stop);
+//! while let Some(bytes) = client.poll_transmit(HostTime::default()) {
+//!     // write `bytes` to the robot, hand its bytes to `client.handle_bytes`
+//! #   let _ = (bytes, seq);
+//! }
 //! ```
 
+pub mod client;
+pub mod driver;
 mod error;
-mod robot;
-mod session;
+pub mod serial;
 pub mod transport;
 
 #[cfg(test)]
-mod tests;
+mod client_tests;
 
-pub use error::{FAULT_NAMES, FaultNames, LinkError, Refusal};
-pub use robot::{
-    DoneReport, LinkOptions, Motion, Robot, RobotInfo, command_name, motion_budget_us,
+pub use client::{
+    Answer, Client, ClientOptions, Event, Handshake, HostTime, LinkStats, MotionEnd, RobotEvent,
 };
-pub use session::{LinkStats, RobotEvent};
+pub use driver::Driver;
+pub use error::{FAULT_NAMES, FaultNames, LinkError, Refusal};
+pub use serial::SerialDriver;

@@ -1,0 +1,148 @@
+//! The in-process driver: the simulated target ([`pushbot_sim::Sim`], the real firmware core
+//! on simulated hardware) stepping on the same bytes a serial port would carry. The client's
+//! host time is the simulated time, so everything runs as fast as the machine goes and is a
+//! function of the seed. It only moves bytes and time: before each tick the client's
+//! transmits go into the simulator, after it the simulator's output goes to the client.
+
+use std::ops::Deref;
+use std::sync::mpsc;
+use std::sync::{Mutex, MutexGuard};
+
+use pushbot_sim::Sim;
+
+use crate::link::driver::{Subscribers, silent};
+use crate::link::{Client, ClientOptions, Driver, HostTime, LinkError, RobotEvent};
+
+/// The simulator and the client.
+pub struct Inner {
+    sim: Sim,
+    client: Client,
+    subscribers: Subscribers,
+    rx: Vec<u8>,
+}
+
+/// The link client on a simulator in process.
+pub struct InProcess {
+    inner: Mutex<Inner>,
+}
+
+/// A view of the simulator (holds the driver's lock).
+pub struct SimRef<'a>(MutexGuard<'a, Inner>);
+
+impl Deref for SimRef<'_> {
+    type Target = Sim;
+    fn deref(&self) -> &Sim {
+        &self.0.sim
+    }
+}
+
+/// The name the in-process target goes by in messages.
+pub const PATH: &str = "in-process simulator";
+
+impl Inner {
+    fn now(&self) -> HostTime {
+        HostTime::from_micros(self.sim.now_us())
+    }
+
+    /// Hand the client's transmits to the simulator and its events to subscribers.
+    fn flush(&mut self) {
+        let now = self.now();
+        while let Some(bytes) = self.client.poll_transmit(now) {
+            self.sim.receive(&bytes);
+        }
+        self.subscribers.dispatch(&mut self.client);
+    }
+
+    /// One tick of the simulator, with the bytes either way.
+    fn step(&mut self) {
+        self.flush();
+        self.sim.tick();
+        let now = self.now();
+        self.rx.clear();
+        self.sim.transmit(&mut self.rx);
+        let rx = std::mem::take(&mut self.rx);
+        self.client.handle_bytes(now, &rx);
+        self.rx = rx;
+        if self.client.poll_timeout().is_some_and(|t| t <= now) {
+            self.client.handle_timeout(now);
+        }
+        self.subscribers.dispatch(&mut self.client);
+    }
+}
+
+impl InProcess {
+    /// Drive `sim` with a client made with `opts`, at the simulator's time.
+    pub fn new(sim: Sim, opts: ClientOptions) -> InProcess {
+        let client = Client::new(HostTime::from_micros(sim.now_us()), opts);
+        InProcess {
+            inner: Mutex::new(Inner {
+                sim,
+                client,
+                subscribers: Subscribers::default(),
+                rx: Vec::new(),
+            }),
+        }
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Inner> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The simulator.
+    pub fn sim(&self) -> SimRef<'_> {
+        SimRef(self.lock())
+    }
+
+    /// Run whole ticks, moving bytes, until at least `seconds` more of simulated time passed.
+    pub fn run_for(&self, seconds: f64) {
+        let mut inner = self.lock();
+        let end = inner.sim.now_us() + (seconds.max(0.0) * 1e6) as u64;
+        while inner.sim.now_us() < end {
+            inner.step();
+        }
+    }
+}
+
+impl Driver for InProcess {
+    fn path(&self) -> &str {
+        PATH
+    }
+
+    fn with_client<T>(&self, f: impl FnOnce(&mut Client, HostTime) -> T) -> Result<T, LinkError> {
+        let mut inner = self.lock();
+        let now = inner.now();
+        let r = f(&mut inner.client, now);
+        inner.flush();
+        Ok(r)
+    }
+
+    fn inspect<T>(&self, f: impl FnOnce(&Client) -> T) -> T {
+        f(&self.lock().client)
+    }
+
+    fn wait<T>(
+        &self,
+        mut f: impl FnMut(&mut Client, HostTime) -> Option<T>,
+    ) -> Result<T, LinkError> {
+        let mut inner = self.lock();
+        loop {
+            let now = inner.now();
+            if let Some(r) = f(&mut inner.client, now) {
+                inner.flush();
+                return Ok(r);
+            }
+            silent(&inner.client, now, PATH)?;
+            inner.step();
+        }
+    }
+
+    fn subscribe(&self) -> mpsc::Receiver<RobotEvent> {
+        self.lock().subscribers.subscribe()
+    }
+
+    fn reopen(&mut self) -> Result<(), LinkError> {
+        Err(LinkError::InvalidArgument(
+            "the in-process simulator cannot be reconnected".into(),
+        ))
+    }
+}

@@ -1,0 +1,379 @@
+//! The in-process robot of the strategy code: a [`Robot`] over the [`InProcess`] driver, so
+//! the simulated firmware is spoken to through the one link client, byte for byte as over a
+//! serial port, stepping simulated time until each primitive's `Done`; its "camera" reads the
+//! simulator's true poses with optional seeded noise (about 1 mm and 0.5°).
+
+use std::time::Duration;
+
+use anyhow::{Context, Result, anyhow, bail};
+use nalgebra::Vector2;
+use pushbot_protocol::{Command, ConfigUpdate, NackReason, Outcome};
+use pushbot_sim::{Scene, Sim, SimOptions};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::inprocess::{InProcess, SimRef};
+use crate::link::{LinkError, Refusal};
+use crate::robot::{LinkOptions, Robot};
+use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
+use crate::strategy::sample::{Pose2, wrap_angle};
+
+/// Settings of the in-process robot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimRobotOptions {
+    /// Seed of the simulation and the camera noise.
+    pub seed: u64,
+    /// Camera position noise (standard deviation), m; 0 for exact poses.
+    pub position_noise: f64,
+    /// Camera heading noise (standard deviation), rad.
+    pub heading_noise: f64,
+    /// Drive speed, m/s.
+    pub speed: f64,
+    /// Spin rate, rad/s.
+    pub spin_rate: f64,
+    /// How far inside the scene's table the object's boundary lies, m. The default, 0.1 m,
+    /// leaves every start position of the Lau presets at least 9 cm inside the boundary (at
+    /// 0.2 m the L-shape's marker at start E lay outside it before the first push).
+    pub boundary_inset: f64,
+    /// Extra table the simulated world gets beyond the scene's table on every side, m, so the
+    /// robot can get behind an object that left the boundary (the paper's table was larger
+    /// than its boundary). With the default 0.25 m, an object that overshoots the boundary by
+    /// a push still leaves the robot room to get behind it; with less, a thin object (the
+    /// snake) pushed against the wall could not be pushed back. Observations stay in the
+    /// scene's coordinates.
+    pub table_margin: f64,
+}
+
+impl Default for SimRobotOptions {
+    fn default() -> Self {
+        SimRobotOptions {
+            seed: 1,
+            position_noise: 0.001,
+            heading_noise: 0.5f64.to_radians(),
+            speed: 0.12,
+            spin_rate: 3.0,
+            boundary_inset: 0.1,
+            table_margin: 0.25,
+        }
+    }
+}
+
+/// The simulated robot, in process, spoken to through the firmware protocol.
+pub struct SimRobot {
+    robot: Robot<InProcess>,
+    opts: SimRobotOptions,
+    rng: ChaCha8Rng,
+    object: usize,
+    marker: [f64; 2],
+    workspace: Workspace,
+    margin: f64,
+}
+
+/// Longest the simulated robot may stay silent (a primitive that never ends: telemetry is off),
+/// s of simulated time.
+const PRIMITIVE_LIMIT_S: u64 = 60;
+/// The robot's link watchdog in process, ms of simulated time.
+const WATCHDOG_MS: u16 = 5000;
+
+impl SimRobot {
+    /// A simulated robot in `scene`, pushing object `object_id` (the first object when `None`),
+    /// which is placed at the scene's named position `start` when given.
+    pub fn new(
+        mut scene: Scene,
+        object_id: Option<&str>,
+        start: Option<&str>,
+        opts: SimRobotOptions,
+    ) -> Result<SimRobot> {
+        let object = match object_id {
+            Some(id) => scene
+                .objects
+                .iter()
+                .position(|o| o.id == id)
+                .ok_or_else(|| anyhow!("scene {} has no object {id:?}", scene.name))?,
+            None if scene.objects.is_empty() => bail!("scene {} has no object", scene.name),
+            None => 0,
+        };
+        if let Some(name) = start {
+            let pose = scene
+                .position(name)
+                .ok_or_else(|| anyhow!("scene {} has no start position {name:?}", scene.name))?;
+            scene.objects[object].pose = pose;
+        }
+        let obj = &scene.objects[object];
+        let marker = obj.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+        let object_radius = obj
+            .outline
+            .iter()
+            .map(|v| (v[0] - marker[0]).hypot(v[1] - marker[1]))
+            .fold(0.0, f64::max);
+        let scene_table = Rect {
+            min: [0.0, 0.0],
+            max: [scene.table.width, scene.table.height],
+        };
+        let m = opts.table_margin;
+        if !(m.is_finite() && (0.0..=1.0).contains(&m)) {
+            bail!("table margin must be 0..=1 m, not {m}");
+        }
+        let table = Rect {
+            min: [-m, -m],
+            max: [scene_table.max[0] + m, scene_table.max[1] + m],
+        };
+        let workspace = Workspace {
+            table,
+            boundary: scene_table.inset(opts.boundary_inset),
+            robot_radius: scene.robot.bumper_radius,
+            object_radius,
+        };
+        if workspace.boundary.min[0] >= workspace.boundary.max[0]
+            || workspace.boundary.min[1] >= workspace.boundary.max[1]
+        {
+            bail!(
+                "boundary inset {} m leaves nothing of the table",
+                opts.boundary_inset
+            );
+        }
+        shift_scene(&mut scene, m);
+        let sim = Sim::new(&SimOptions {
+            seed: opts.seed,
+            speed: 0.0,
+            scene: Some(scene),
+            ..SimOptions::default()
+        })?;
+        let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+        rng.set_stream(7);
+        let link = LinkOptions {
+            dead_link_timeout: Duration::from_secs(PRIMITIVE_LIMIT_S),
+            ..LinkOptions::default()
+        };
+        let driver = InProcess::new(sim, link.client_options(1));
+        let robot = Robot::over(driver, link)
+            .map_err(|e| anyhow!("the simulated robot refused the session: {e}"))?;
+        let cfg = ConfigUpdate {
+            watchdog_ms: Some(WATCHDOG_MS),
+            telemetry_hz: Some(0),
+            ..ConfigUpdate::default()
+        };
+        robot
+            .configure(cfg)
+            .map_err(|e| anyhow!("the simulated robot refused the configuration: {e}"))?;
+        Ok(SimRobot {
+            robot,
+            opts,
+            rng,
+            object,
+            marker,
+            workspace,
+            margin: m,
+        })
+    }
+
+    /// The simulator (for true poses, figures and tests).
+    pub fn sim(&self) -> SimRef<'_> {
+        self.robot.driver().sim()
+    }
+
+    /// The robot interface the primitives go through.
+    pub fn robot(&self) -> &Robot<InProcess> {
+        &self.robot
+    }
+
+    /// The object's true marker pose (no camera noise).
+    pub fn true_object_pose(&self) -> Pose2 {
+        let poses = self.sim().object_poses();
+        let p = poses.get(self.object).map_or(
+            pushbot_sim::Pose::new(f64::NAN, f64::NAN, f64::NAN),
+            |(_, p)| *p,
+        );
+        let o = Pose2::new(p.x - self.margin, p.y - self.margin, p.theta);
+        let m = o.point_to_world(Vector2::new(self.marker[0], self.marker[1]));
+        Pose2::new(m.x, m.y, p.theta)
+    }
+
+    /// The robot's true pose.
+    pub fn true_robot_pose(&self) -> Pose2 {
+        let p = self.sim().truth().pose;
+        Pose2::new(p.x - self.margin, p.y - self.margin, p.theta)
+    }
+
+    /// Run one motion command to its `Done`; a latched fault (a stall against something that
+    /// does not move) is cleared and the motion counts as ended.
+    fn motion(&mut self, cmd: Command) -> Result<()> {
+        for attempt in 0..2 {
+            let started = match self.robot.start(cmd) {
+                Ok(m) => m,
+                Err(LinkError::Refused {
+                    reason: Refusal(NackReason::Faulted(_)),
+                    ..
+                }) if attempt == 0 => {
+                    self.clear_faults()?;
+                    continue;
+                }
+                Err(e) => bail!("the robot refused {cmd:?}: {e}"),
+            };
+            let done = self
+                .robot
+                .wait(&started)
+                .map_err(|e| anyhow!("{cmd:?} did not end: {e}"))?;
+            if let Outcome::Fault(_) = done.outcome {
+                self.clear_faults()?;
+            }
+            return Ok(());
+        }
+        bail!("the robot stayed faulted")
+    }
+
+    fn clear_faults(&mut self) -> Result<()> {
+        // Faults clear only once their cause has been quiet for a while.
+        for _ in 0..20 {
+            self.robot.driver().run_for(0.1);
+            match self.robot.request(Command::ClearFaults) {
+                Ok(_) | Err(LinkError::Refused { .. }) => {}
+                Err(e) => return Err(e).context("clearing faults"),
+            }
+            if self.sim().truth().faults.is_empty() {
+                return Ok(());
+            }
+        }
+        bail!("faults {:?} would not clear", self.sim().truth().faults)
+    }
+
+    fn noisy(&mut self, p: Pose2) -> Pose2 {
+        if self.opts.position_noise <= 0.0 && self.opts.heading_noise <= 0.0 {
+            return p;
+        }
+        let (a, b, c) = (
+            gaussian(&mut self.rng),
+            gaussian(&mut self.rng),
+            gaussian(&mut self.rng),
+        );
+        Pose2::new(
+            p.x + self.opts.position_noise * a,
+            p.y + self.opts.position_noise * b,
+            wrap_angle(p.theta + self.opts.heading_noise * c),
+        )
+    }
+}
+
+/// A standard normal draw (Box–Muller). Kept instead of `rand_distr::StandardNormal`: that
+/// draws other values from the same stream, and the seeded strategy tests
+/// (`host/tests/strategy_sim.rs`) were tuned on these.
+fn gaussian(rng: &mut impl Rng) -> f64 {
+    let u1: f64 = rng.random_range(f64::EPSILON..1.0);
+    let u2: f64 = rng.random_range(0.0..1.0);
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// Grow the scene's table by `m` on every side, moving everything on it along.
+fn shift_scene(scene: &mut Scene, m: f64) {
+    scene.table.width += 2.0 * m;
+    scene.table.height += 2.0 * m;
+    let mv = |p: &mut pushbot_sim::Pose| {
+        p.x += m;
+        p.y += m;
+    };
+    mv(&mut scene.robot.start);
+    scene.objects.iter_mut().for_each(|o| mv(&mut o.pose));
+    scene.goals.iter_mut().for_each(|g| mv(&mut g.pose));
+    scene.positions.iter_mut().for_each(|p| mv(&mut p.pose));
+    for o in &mut scene.obstacles {
+        for v in &mut o.outline {
+            v[0] += m;
+            v[1] += m;
+        }
+    }
+}
+
+impl RobotIo for SimRobot {
+    fn spin(&mut self, angle: f64) -> Result<()> {
+        let angle = wrap_angle(angle);
+        if !angle.is_finite() || angle.abs() < 1e-3 {
+            return Ok(());
+        }
+        self.motion(Command::Spin {
+            angle: angle as f32,
+            rate: self.opts.spin_rate as f32,
+        })
+    }
+
+    fn forward(&mut self, distance: f64) -> Result<()> {
+        if !distance.is_finite() || distance.abs() < 5e-4 {
+            return Ok(());
+        }
+        self.motion(Command::Move {
+            distance: distance.clamp(-2.0, 2.0) as f32,
+            speed: self.opts.speed as f32,
+            stop_on_contact: false,
+        })
+    }
+
+    fn drive(&mut self, v: f64, omega: f64, duration: f64) -> Result<()> {
+        let ms = (duration * 1e3).clamp(1.0, 60_000.0) as u16;
+        self.motion(Command::Velocity {
+            v: v.clamp(-0.3, 0.3) as f32,
+            omega: omega.clamp(-4.0, 4.0) as f32,
+            timeout_ms: ms,
+        })
+    }
+
+    fn robot_pose(&mut self) -> Pose2 {
+        let p = self.true_robot_pose();
+        self.noisy(p)
+    }
+
+    fn object_pose(&mut self) -> Pose2 {
+        let p = self.true_object_pose();
+        self.noisy(p)
+    }
+
+    fn body_pose(&mut self, id: &str) -> Option<Pose2> {
+        let (_, p) = self
+            .sim()
+            .object_poses()
+            .into_iter()
+            .find(|(o, _)| o == id)?;
+        let p = Pose2::new(p.x - self.margin, p.y - self.margin, p.theta);
+        Some(self.noisy(p))
+    }
+
+    fn time(&self) -> f64 {
+        self.sim().now_us() as f64 * 1e-6
+    }
+
+    fn workspace(&self) -> Workspace {
+        self.workspace
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn primitives_move_the_simulated_robot_through_the_protocol() {
+        let scene = Scene::preset("lau-irregular").unwrap();
+        let mut r = SimRobot::new(
+            scene,
+            None,
+            Some("C"),
+            SimRobotOptions {
+                position_noise: 0.0,
+                heading_noise: 0.0,
+                ..SimRobotOptions::default()
+            },
+        )
+        .unwrap();
+        let a = r.robot_pose();
+        r.spin(std::f64::consts::FRAC_PI_2).unwrap();
+        r.forward(0.1).unwrap();
+        let b = r.robot_pose();
+        assert!((wrap_angle(b.theta - a.theta) - std::f64::consts::FRAC_PI_2).abs() < 0.05);
+        assert!(
+            (b.y - a.y - 0.1).abs() < 0.01 && (b.x - a.x).abs() < 0.01,
+            "{a:?} {b:?}"
+        );
+        // Object C is at (0.45, 0.25), marker at the origin of the outline.
+        let o = r.object_pose();
+        assert!((o.x - 0.45).abs() < 1e-9 && (o.y - 0.25).abs() < 1e-9);
+        assert!(r.time() > 1.0);
+    }
+}
