@@ -4,7 +4,6 @@
 //! robot's displacement (r), the object's displacement (s), all in the object's frame at the
 //! start of the push, and the object's change of heading θ.
 
-
 /// A planar pose in table coordinates: the world crate's one pose.
 pub use pushbot_world::Pose as Pose2;
 pub use pushbot_world::wrap_angle;
