@@ -19,6 +19,10 @@ fn circle(n: usize, r: f64) -> Vec<[f64; 2]> {
 fn a_100000_vertex_circle_is_simple() {
     let c = circle(100_000, 0.4);
     assert_eq!(check_simple(&c), Ok(()));
+    // And it makes an outline (one convex part): a point inside, one outside.
+    let o = Outline::polygon(&c).expect("an outline");
+    let at = pushbot_world::Pose::default();
+    assert!(o.contains(&at, [0.6, 0.45]) && !o.contains(&at, [1.01, 0.45]));
     let mut cw = c.clone();
     cw.reverse();
     assert_eq!(check_simple(&cw), Ok(()));
