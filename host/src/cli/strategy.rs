@@ -214,34 +214,6 @@ pub(super) fn progress_bar(global: &Global, len: u64) -> ProgressBar {
     pb
 }
 
-pub(super) fn scene_for(
-    object: &str,
-    scene: Option<&str>,
-) -> Result<(Scene, Option<String>), CliError> {
-    let (name, id) = match scene {
-        Some(s) => (s.to_owned(), Some(object.to_owned())),
-        None => (format!("lau-{object}"), None),
-    };
-    let scene = Scene::preset_or_file(&name).map_err(|e| CliError::bad_input(e.to_string()))?;
-    Ok((scene, id))
-}
-
-/// The object's outline relative to its marker (for figures).
-pub(super) fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
-    let obj = match id {
-        Some(id) => scene.object(id),
-        None => scene.objects.first(),
-    };
-    obj.map(|o| {
-        let m = o.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
-        o.outline
-            .iter()
-            .map(|v| [v[0] - m[0], v[1] - m[1]])
-            .collect()
-    })
-    .unwrap_or_default()
-}
-
 /// Run `pushbot eval`.
 pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     let EvalCmd::Delivery(a) = a.cmd;

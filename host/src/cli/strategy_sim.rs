@@ -7,9 +7,7 @@ use std::path::PathBuf;
 use pushbot_world::Scene;
 use serde_json::json;
 
-use super::strategy::{
-    CollectArgs, DeliveryArgs, MethodArg, SimArgs, object_outline, progress_bar, scene_for,
-};
+use super::strategy::{CollectArgs, DeliveryArgs, MethodArg, SimArgs, progress_bar};
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::experiments::delivery::collect_or_load;
@@ -23,6 +21,31 @@ use crate::strategy::figures;
 use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::Sample;
 use crate::strategy::store::{self, StrategyWriter};
+
+fn scene_for(object: &str, scene: Option<&str>) -> Result<(Scene, Option<String>), CliError> {
+    let (name, id) = match scene {
+        Some(s) => (s.to_owned(), Some(object.to_owned())),
+        None => (format!("lau-{object}"), None),
+    };
+    let scene = Scene::preset_or_file(&name).map_err(|e| CliError::bad_input(e.to_string()))?;
+    Ok((scene, id))
+}
+
+/// The object's outline relative to its marker (for figures).
+fn object_outline(scene: &Scene, id: Option<&str>) -> Vec<[f64; 2]> {
+    let obj = match id {
+        Some(id) => scene.object(id),
+        None => scene.objects.first(),
+    };
+    obj.map(|o| {
+        let m = o.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
+        o.outline
+            .iter()
+            .map(|v| [v[0] - m[0], v[1] - m[1]])
+            .collect()
+    })
+    .unwrap_or_default()
+}
 
 impl SimArgs {
     pub(super) fn options(&self, seed: u64) -> Result<SimRobotOptions, CliError> {

@@ -71,6 +71,22 @@ impl Inner {
 }
 
 impl InProcess {
+    /// The simulated target serving `scene` with every random draw from `seed`, stepped only
+    /// while the host waits (no wall clock), driven with a client made with `opts`.
+    pub fn start(
+        scene: pushbot_world::Scene,
+        seed: u64,
+        opts: ClientOptions,
+    ) -> anyhow::Result<InProcess> {
+        let sim = Sim::new(&pushbot_sim::SimOptions {
+            seed,
+            speed: 0.0,
+            scene: Some(scene),
+            ..pushbot_sim::SimOptions::default()
+        })?;
+        Ok(InProcess::new(sim, opts))
+    }
+
     /// Drive `sim` with a client made with `opts`, at the simulator's time.
     pub fn new(sim: Sim, opts: ClientOptions) -> InProcess {
         let client = Client::new(HostTime::from_micros(sim.now_us()), opts);

@@ -8,7 +8,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, anyhow, bail};
 use nalgebra::Vector2;
 use pushbot_protocol::{Command, ConfigUpdate, NackReason, Outcome};
-use pushbot_sim::{Scene, Sim, SimOptions};
+use pushbot_world::Scene;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -133,19 +133,13 @@ impl SimRobot {
             );
         }
         shift_scene(&mut scene, m);
-        let sim = Sim::new(&SimOptions {
-            seed: opts.seed,
-            speed: 0.0,
-            scene: Some(scene),
-            ..SimOptions::default()
-        })?;
         let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
         rng.set_stream(7);
         let link = LinkOptions {
             dead_link_timeout: Duration::from_secs(PRIMITIVE_LIMIT_S),
             ..LinkOptions::default()
         };
-        let driver = InProcess::new(sim, link.client_options(1));
+        let driver = InProcess::start(scene, opts.seed, link.client_options(1))?;
         let robot = Robot::over(driver, link)
             .map_err(|e| anyhow!("the simulated robot refused the session: {e}"))?;
         let cfg = ConfigUpdate {
@@ -180,10 +174,9 @@ impl SimRobot {
     /// The object's true marker pose (no camera noise).
     pub fn true_object_pose(&self) -> Pose2 {
         let poses = self.sim().object_poses();
-        let p = poses.get(self.object).map_or(
-            pushbot_sim::Pose::new(f64::NAN, f64::NAN, f64::NAN),
-            |(_, p)| *p,
-        );
+        let p = poses
+            .get(self.object)
+            .map_or(Pose2::new(f64::NAN, f64::NAN, f64::NAN), |(_, p)| *p);
         let o = Pose2::new(p.x - self.margin, p.y - self.margin, p.theta);
         let m = o.point_to_world(Vector2::new(self.marker[0], self.marker[1]));
         Pose2::new(m.x, m.y, p.theta)
@@ -267,7 +260,7 @@ fn gaussian(rng: &mut impl Rng) -> f64 {
 fn shift_scene(scene: &mut Scene, m: f64) {
     scene.table.width += 2.0 * m;
     scene.table.height += 2.0 * m;
-    let mv = |p: &mut pushbot_sim::Pose| {
+    let mv = |p: &mut Pose2| {
         p.x += m;
         p.y += m;
     };

@@ -142,7 +142,7 @@ impl CostSpec {
     }
 }
 
-/// Names of the built-in presets: scenes of `pushbot_sim`'s shared format with a `[stable]`
+/// Names of the built-in presets: scenes of the shared scene format (`pushbot_world::scene`) with a `[stable]`
 /// section.
 pub const PRESETS: [&str; 5] = ["fig13", "fig15", "fig16", "fig17", "fig18"];
 
