@@ -8,11 +8,11 @@
 //! static file server), the camera image and overlay are plain PNG and SVG that stay in the
 //! report afterwards, and it adds no heavy dependency to the host build.
 
-use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use crate::plot::svg::{Doc, Draw, Style};
 use crate::vision::FrameResult;
 use crate::vision::calibration::Calibration;
 use crate::vision::source::Frame;
@@ -83,36 +83,14 @@ pub fn overlay_svg(
     cal: &Calibration,
     plan: &[[f64; 2]],
 ) -> String {
-    let (w, h) = (frame.width, frame.height);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {w} {h}" width="{w}" height="{h}">"#
-    );
-    for d in &result.detections {
-        let pts: Vec<String> = d
-            .corners
-            .iter()
-            .map(|c| format!("{:.1},{:.1}", c[0], c[1]))
-            .collect();
-        let _ = writeln!(
-            s,
-            r#"<polygon points="{}" fill="none" stroke="lime" stroke-width="2"/>"#,
-            pts.join(" ")
-        );
+    let mut d = Doc::new(f64::from(frame.width), f64::from(frame.height));
+    for det in &result.detections {
+        d.polygon(&det.corners, &Style::outline("lime", 2.0));
     }
     let px = |x: f64, y: f64| cal.table_to_pixel.apply([x, y]);
     if plan.len() >= 2 {
-        let pts: Vec<String> = plan
-            .iter()
-            .filter_map(|p| px(p[0], p[1]))
-            .map(|q| format!("{:.1},{:.1}", q[0], q[1]))
-            .collect();
-        let _ = writeln!(
-            s,
-            r#"<polyline points="{}" fill="none" stroke="orange" stroke-width="3" stroke-dasharray="8,6"/>"#,
-            pts.join(" ")
-        );
+        let pts: Vec<[f64; 2]> = plan.iter().filter_map(|p| px(p[0], p[1])).collect();
+        d.polyline(&pts, &Style::outline("orange", 3.0).dash("8,6"));
     }
     for t in &result.tracked {
         let (Some(a), Some(b)) = (
@@ -125,27 +103,25 @@ pub fn overlay_svg(
             continue;
         };
         let colour = if t.seen { "#ff3b30" } else { "#999" };
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{:.1}" cy="{:.1}" r="5" fill="{colour}"/><line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{colour}" stroke-width="3"/><text x="{:.1}" y="{:.1}" fill="{colour}" font-family="sans-serif" font-size="16">{} ({:.3}, {:.3}, {:.0}°)</text>"#,
-            a[0],
-            a[1],
-            a[0],
-            a[1],
-            b[0],
-            b[1],
-            a[0] + 8.0,
-            a[1] - 8.0,
-            crate::report::html::escape(&t.body),
+        d.circle(a, 5.0, &Style::new().fill(colour));
+        d.line(a, b, &Style::new().stroke(colour).width(3.0));
+        let label = format!(
+            "{} ({:.3}, {:.3}, {:.0}°)",
+            t.body,
             t.pose.x,
             t.pose.y,
             t.pose.theta.to_degrees()
         );
+        d.text(
+            [a[0] + 8.0, a[1] - 8.0],
+            &label,
+            &Style::new().fill(colour).font_size(16.0),
+        );
     }
-    let _ = writeln!(
-        s,
-        r#"<text x="8" y="22" fill="yellow" font-family="sans-serif" font-size="18">t = {:.2} s, frame {}</text></svg>"#,
-        result.time, result.seq
+    d.caption(
+        &format!("t = {:.2} s, frame {}", result.time, result.seq),
+        18.0,
+        &Style::new().fill("yellow"),
     );
-    s
+    d.to_string()
 }

@@ -1,5 +1,7 @@
-//! Plots shared by every command: SVG figures rendered to PNG ([`svg_to_png`]).
+//! Plots shared by every command: SVG figures built with [`svg`] (a document builder and a
+//! table-to-picture [`svg::Frame`]) and rendered to PNG ([`svg_to_png`]).
 
 mod png;
+pub mod svg;
 
 pub use png::{render_png, svg_to_png};

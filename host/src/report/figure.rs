@@ -3,77 +3,47 @@
 //! outline where it started (dashed) and where it ended (solid), the object paths (red) and the
 //! robot's path (blue), with the robot drawn at the start and at the end.
 
-use std::fmt::Write;
-
 use pushbot_world::Scene;
 use pushbot_world::scene::placed;
 
 use crate::exec::record::TracePoint;
+use crate::plot::svg::{Doc, Draw, Frame, Style};
 use crate::strategy::sample::Pose2;
 
 /// Pixels per metre.
 const SCALE: f64 = 600.0;
-
-fn points(pts: &[[f64; 2]], h: f64) -> String {
-    pts.iter()
-        .map(|p| format!("{:.1},{:.1}", p[0] * SCALE, h - p[1] * SCALE))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
+/// Room above the table for the title.
+const BAND: f64 = 28.0;
 
 fn outline_at(scene: &Scene, id: &str, pose: &Pose2) -> Option<Vec<[f64; 2]>> {
     let o = scene.object(id)?;
-    Some(placed(
-        &o.outline,
-        &pushbot_world::Pose::new(pose.x, pose.y, pose.theta),
-    ))
+    Some(placed(&o.outline, pose))
 }
 
 /// The run `trace` over `scene`, titled `title`; `truth` draws the simulator's true paths
 /// instead of the camera's when the trace has them.
 pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) -> String {
-    let (w, h) = (scene.table.width * SCALE, scene.table.height * SCALE);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{:.0}" viewBox="0 -28 {w:.0} {:.0}">"#,
-        h + 28.0,
-        h + 28.0
+    let f = Frame::table(scene.table.width, scene.table.height, SCALE).with_band(BAND);
+    let mut d = Doc::for_frame(&f);
+    d.title(title);
+    let (at, size) = f.area();
+    d.rect(
+        at,
+        size,
+        &Style::new().fill("#f6f6f2").stroke("black").width(2.0),
     );
-    let _ = writeln!(
-        s,
-        r##"<rect x="0" y="0" width="{w:.1}" height="{h:.1}" fill="#f6f6f2" stroke="black" stroke-width="2"/>"##
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="4" y="-9" font-family="sans-serif" font-size="16">{}</text>"#,
-        super::html::escape(title)
-    );
+    d.caption(title, 16.0, &Style::new());
     for o in &scene.obstacles {
-        let _ = writeln!(
-            s,
-            r##"<polygon points="{}" fill="#555"/>"##,
-            points(&o.outline, h)
-        );
+        d.polygon(&f.map_all(&o.outline), &Style::new().fill("#555"));
     }
     for g in &scene.goals {
-        if let Some(pts) = outline_at(
-            scene,
-            &g.object,
-            &Pose2::new(g.pose.x, g.pose.y, g.pose.theta),
-        ) {
-            let _ = writeln!(
-                s,
-                r#"<polygon points="{}" fill="none" stroke="green" stroke-width="1.5" stroke-dasharray="2,3"/>"#,
-                points(&pts, h)
-            );
+        if let Some(pts) = outline_at(scene, &g.object, &g.pose) {
+            d.polygon(&f.map_all(&pts), &Style::outline("green", 1.5).dash("2,3"));
         }
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="green" opacity="0.35"/>"#,
-            g.pose.x * SCALE,
-            h - g.pose.y * SCALE,
-            (g.tolerance * SCALE).max(3.0)
+        d.circle(
+            f.map([g.pose.x, g.pose.y]),
+            f.length(g.tolerance).max(3.0),
+            &Style::new().fill("green").opacity(0.35),
         );
     }
     let pick = |p: &TracePoint| -> (Pose2, Vec<(String, Pose2)>) {
@@ -93,52 +63,44 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
             continue;
         };
         if let Some(pts) = outline_at(scene, &o.id, first) {
-            let _ = writeln!(
-                s,
-                r##"<polygon points="{}" fill="none" stroke="#888" stroke-dasharray="4,3"/>"##,
-                points(&pts, h)
+            d.polygon(
+                &f.map_all(&pts),
+                &Style::new().fill("none").stroke("#888").dash("4,3"),
             );
         }
         if let Some(pts) = outline_at(scene, &o.id, last) {
-            let _ = writeln!(
-                s,
-                r##"<polygon points="{}" fill="#e8c26a" fill-opacity="0.7" stroke="#7a5a00"/>"##,
-                points(&pts, h)
+            d.polygon(
+                &f.map_all(&pts),
+                &Style::new()
+                    .fill("#e8c26a")
+                    .fill_opacity(0.7)
+                    .stroke("#7a5a00"),
             );
         }
-        let line: Vec<[f64; 2]> = path.iter().map(|p| [p.x, p.y]).collect();
-        let _ = writeln!(
-            s,
-            r#"<polyline points="{}" fill="none" stroke="red" stroke-width="2"><title>{}</title></polyline>"#,
-            points(&line, h),
-            super::html::escape(&o.id)
-        );
+        let line: Vec<[f64; 2]> = path.iter().map(|p| f.map([p.x, p.y])).collect();
+        d.polyline(&line, &Style::outline("red", 2.0).tip(&o.id));
     }
     let robot: Vec<[f64; 2]> = poses
         .iter()
         .map(|(r, _)| [r.x, r.y])
         .filter(|p| p[0].is_finite() && p[1].is_finite())
         .collect();
-    let _ = writeln!(
-        s,
-        r#"<polyline points="{}" fill="none" stroke="blue" stroke-width="1.2" opacity="0.8"/>"#,
-        points(&robot, h)
+    d.polyline(
+        &f.map_all(&robot),
+        &Style::outline("blue", 1.2).opacity(0.8),
     );
-    let r = scene.robot.bumper_radius * SCALE;
+    let r = f.length(scene.robot.bumper_radius);
     for (p, fill) in [(robot.first(), "#9bb8ff"), (robot.last(), "#3b6cf0")] {
         if let Some(p) = p {
-            let _ = writeln!(
-                s,
-                r#"<circle cx="{:.1}" cy="{:.1}" r="{r:.1}" fill="{fill}" fill-opacity="0.6" stroke="blue"/>"#,
-                p[0] * SCALE,
-                h - p[1] * SCALE
+            d.circle(
+                f.map(*p),
+                r,
+                &Style::new().fill(fill).fill_opacity(0.6).stroke("blue"),
             );
         }
     }
-    s.push_str("</svg>\n");
-    s
+    d.to_string()
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;

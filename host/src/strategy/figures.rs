@@ -3,27 +3,15 @@
 //! marker, one colour per sample, over the object's outline) and delivery trajectories (Fig. 8:
 //! robot blue, object red).
 
-use std::fmt::Write;
-
 use nalgebra::Vector2;
 use pushbot_world::Scene;
 
 use super::sample::{Pose2, Sample};
+use crate::plot::svg::{Doc, Draw, Frame, Style};
 
 fn colour(i: usize, n: usize) -> String {
     let hue = 360.0 * i as f64 / n.max(1) as f64;
     format!("hsl({hue:.0},80%,45%)")
-}
-
-fn polygon(points: &[[f64; 2]], map: impl Fn([f64; 2]) -> (f64, f64)) -> String {
-    points
-        .iter()
-        .map(|p| {
-            let (x, y) = map(*p);
-            format!("{x:.1},{y:.1}")
-        })
-        .collect::<Vec<_>>()
-        .join(" ")
 }
 
 /// The pushing strategy in the object's frame (marker at the centre), 1 px = 0.5 mm.
@@ -34,36 +22,28 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
         .chain(outline.iter().flat_map(|v| [v[0].abs(), v[1].abs()]))
         .fold(0.1f64, f64::max)
         + 0.05;
-    let scale = 2000.0; // px per m
-    let size = 2.0 * half * scale;
-    let map = |p: [f64; 2]| ((p[0] + half) * scale, (half - p[1]) * scale);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{size:.0}" height="{size:.0}" viewBox="0 0 {size:.0} {size:.0}">"#
+    let f = Frame::region([-half, -half], [half, half], 2000.0);
+    let mut d = Doc::for_frame(&f);
+    d.background(&Style::new().fill("white"));
+    d.polygon(
+        &f.map_all(outline),
+        &Style::new().fill("lightgrey").stroke("black"),
     );
-    let _ = writeln!(
-        s,
-        r#"<rect width="100%" height="100%" fill="white"/><polygon points="{}" fill="lightgrey" stroke="black"/>"#,
-        polygon(outline, map)
-    );
+    let marker = f.map([0.0, 0.0]);
     for (i, smp) in samples.iter().enumerate() {
         let c = colour(i, samples.len());
-        let (x0, y0) = map(smp.p);
-        let (x1, y1) = map([smp.p[0] + smp.r[0], smp.p[1] + smp.r[1]]);
-        let (sx, sy) = map(smp.s);
-        let (ox, oy) = map([0.0, 0.0]);
-        let _ = writeln!(
-            s,
-            r#"<line x1="{x0:.1}" y1="{y0:.1}" x2="{x1:.1}" y2="{y1:.1}" stroke="{c}" stroke-width="1.5"/><circle cx="{x0:.1}" cy="{y0:.1}" r="2" fill="{c}"/><line x1="{ox:.1}" y1="{oy:.1}" x2="{sx:.1}" y2="{sy:.1}" stroke="{c}" stroke-width="1" opacity="0.6"/>"#
+        let p = f.map(smp.p);
+        let r = f.map([smp.p[0] + smp.r[0], smp.p[1] + smp.r[1]]);
+        d.line(p, r, &Style::new().stroke(&c).width(1.5));
+        d.circle(p, 2.0, &Style::new().fill(&c));
+        d.line(
+            marker,
+            f.map(smp.s),
+            &Style::new().stroke(&c).width(1.0).opacity(0.6),
         );
     }
-    let _ = writeln!(
-        s,
-        r#"<text x="8" y="20" font-family="sans-serif" font-size="16">{} samples</text></svg>"#,
-        samples.len()
-    );
-    s
+    d.caption(&format!("{} samples", samples.len()), 16.0, &Style::new());
+    d.to_string()
 }
 
 /// Trajectories of robot (blue) and object marker (red) on the scene's table, one group per
@@ -73,47 +53,26 @@ pub fn trajectories_svg(
     scene: &Scene,
     goal: Vector2<f64>,
 ) -> String {
-    let scale = 500.0;
-    let (w, h) = (scene.table.width * scale, scene.table.height * scale);
-    let map = |x: f64, y: f64| (x * scale, h - y * scale);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.0} {h:.0}"><rect width="100%" height="100%" fill="white" stroke="black"/>"#
-    );
-    let (gx, gy) = map(goal.x, goal.y);
-    let _ = writeln!(
-        s,
-        r#"<circle cx="{gx:.1}" cy="{gy:.1}" r="{:.1}" fill="none" stroke="green" stroke-width="2"/>"#,
-        0.022 * scale
+    let f = Frame::table(scene.table.width, scene.table.height, 500.0);
+    let mut d = Doc::for_frame(&f);
+    d.background(&Style::new().fill("white").stroke("black"));
+    d.circle(
+        f.map([goal.x, goal.y]),
+        f.length(0.022),
+        &Style::outline("green", 2.0),
     );
     for p in &scene.positions {
-        let (x, y) = map(p.pose.x, p.pose.y);
-        let _ = writeln!(
-            s,
-            r#"<text x="{x:.1}" y="{y:.1}" font-family="sans-serif" font-size="14">{}</text>"#,
-            p.name
-        );
+        let at = f.map([p.pose.x, p.pose.y]);
+        d.text(at, &p.name, &Style::new().font_size(14.0));
     }
     for (label, traj) in runs {
-        for (pick, colour) in [(0usize, "blue"), (1, "red")] {
-            let pts: Vec<String> = traj
-                .iter()
-                .map(|(r, o)| {
-                    let q = if pick == 0 { r } else { o };
-                    let (x, y) = map(q.x, q.y);
-                    format!("{x:.1},{y:.1}")
-                })
-                .collect();
-            let _ = writeln!(
-                s,
-                r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="1.5"><title>{label}</title></polyline>"#,
-                pts.join(" ")
-            );
+        let robot: Vec<[f64; 2]> = traj.iter().map(|(r, _)| f.map([r.x, r.y])).collect();
+        let object: Vec<[f64; 2]> = traj.iter().map(|(_, o)| f.map([o.x, o.y])).collect();
+        for (pts, colour) in [(robot, "blue"), (object, "red")] {
+            d.polyline(&pts, &Style::outline(colour, 1.5).tip(label));
         }
     }
-    s.push_str("</svg>\n");
-    s
+    d.to_string()
 }
 
 #[cfg(test)]

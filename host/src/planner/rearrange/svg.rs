@@ -4,14 +4,15 @@
 //! where movables may not be left hatched, goals dashed outlines, movables where the stage
 //! leaves them (faint where it found them).
 
-use std::fmt::Write;
-
 use super::admissibility::MoveKind;
 use super::problem::{Config, Model};
 use super::restore::Plan;
+use crate::plot::svg::{Doc, Draw, Group, Style};
 
 const CELL: f64 = 18.0;
 const PAD: f64 = 10.0;
+/// The robot, its path and the path's arrowhead.
+const BLUE: &str = "#1c7ed6";
 const COLORS: [&str; 4] = ["#d9822b", "#2b8a3e", "#7048e8", "#c2255c"];
 
 /// The plan's stages: index ranges of steps, each transit moves then push moves.
@@ -32,50 +33,41 @@ pub fn stages(plan: &Plan) -> Vec<std::ops::Range<usize>> {
     out
 }
 
-fn centre(model: &Model, x: i32, y: i32, size: i32) -> (f64, f64) {
-    let _ = model;
-    (
+fn centre(x: i32, y: i32, size: i32) -> [f64; 2] {
+    [
         (x as f64 + size as f64 / 2.0) * CELL,
         (y as f64 + size as f64 / 2.0) * CELL,
-    )
+    ]
 }
 
-fn draw_movables(s: &mut String, model: &Model, c: &Config, opacity: f64, outline_only: bool) {
+fn draw_movables(g: &mut Group, model: &Model, c: &Config, opacity: f64, outline_only: bool) {
     for (i, p) in c.movables.iter().enumerate() {
         let spec = &model.problem.movables[i];
         let col = COLORS[i % COLORS.len()];
+        let style = if outline_only {
+            Style::outline(col, 1.5).dash("3,2")
+        } else {
+            Style::new().fill(col).fill_opacity(opacity).stroke(col)
+        };
         for (cx, cy) in spec.cells_at(p.o) {
-            let (x, y) = ((p.x + cx) as f64 * CELL, (p.y + cy) as f64 * CELL);
-            if outline_only {
-                let _ = write!(
-                    s,
-                    r#"<rect x="{x}" y="{y}" width="{CELL}" height="{CELL}" fill="none" stroke="{col}" stroke-dasharray="3,2" stroke-width="1.5"/>"#
-                );
-            } else {
-                let _ = write!(
-                    s,
-                    r#"<rect x="{x}" y="{y}" width="{CELL}" height="{CELL}" fill="{col}" fill-opacity="{opacity}" stroke="{col}"/>"#
-                );
-            }
+            let at = [(p.x + cx) as f64 * CELL, (p.y + cy) as f64 * CELL];
+            g.rect(at, [CELL, CELL], &style);
         }
         if !outline_only && opacity > 0.5 {
-            let (x, y) = ((p.x as f64 + 0.5) * CELL, (p.y as f64 + 0.5) * CELL + 4.0);
-            let _ = write!(
-                s,
-                r#"<text x="{x}" y="{y}" font-size="11" text-anchor="middle" fill="white">{}</text>"#,
-                spec.name
-            );
+            let at = [(p.x as f64 + 0.5) * CELL, (p.y as f64 + 0.5) * CELL + 4.0];
+            let label = Style::new().fill("white").font_size(11.0).anchor("middle");
+            g.text(at, &spec.name, &label);
         }
     }
 }
 
-fn panel(s: &mut String, model: &Model, before: &Config, steps: &[&Config], title: &str) {
-    let g = &model.problem.grid;
+fn panel(g: &mut Group, model: &Model, before: &Config, steps: &[&Config], title: &str) {
+    let grid = &model.problem.grid;
     let k = model.problem.robot.size;
-    let _ = write!(s, r#"<text x="0" y="-3" font-size="11">{title}</text>"#);
-    for y in 0..g.h {
-        for x in 0..g.w {
-            let c = g.cells[(y * g.w + x) as usize];
+    g.text([0.0, -3.0], title, &Style::new().font_size(11.0));
+    for y in 0..grid.h {
+        for x in 0..grid.w {
+            let c = grid.cells[(y * grid.w + x) as usize];
             let fill = if c.obstacle {
                 "#222"
             } else if c.rough == 2 {
@@ -85,19 +77,11 @@ fn panel(s: &mut String, model: &Model, before: &Config, steps: &[&Config], titl
             } else {
                 "#fff"
             };
-            let _ = write!(
-                s,
-                r##"<rect x="{}" y="{}" width="{CELL}" height="{CELL}" fill="{fill}" stroke="#eee"/>"##,
-                x as f64 * CELL,
-                y as f64 * CELL
-            );
+            let at = [x as f64 * CELL, y as f64 * CELL];
+            g.rect(at, [CELL, CELL], &Style::new().fill(fill).stroke("#eee"));
             if c.no_leave {
-                let _ = write!(
-                    s,
-                    r##"<path d="M{} {}l{CELL} {CELL}" stroke="#999"/>"##,
-                    x as f64 * CELL,
-                    y as f64 * CELL
-                );
+                let end = [at[0] + CELL, at[1] + CELL];
+                g.line(at, end, &Style::new().stroke("#999"));
             }
         }
     }
@@ -116,68 +100,52 @@ fn panel(s: &mut String, model: &Model, before: &Config, steps: &[&Config], titl
             })
             .collect(),
     };
-    draw_movables(s, model, &goal, 1.0, true);
-    draw_movables(s, model, before, 0.25, false);
+    draw_movables(g, model, &goal, 1.0, true);
+    draw_movables(g, model, before, 0.25, false);
     let last = steps.last().copied().unwrap_or(before);
-    draw_movables(s, model, last, 0.9, false);
+    draw_movables(g, model, last, 0.9, false);
     // robot path
-    let mut pts = vec![centre(model, before.robot.0, before.robot.1, k)];
-    pts.extend(steps.iter().map(|c| centre(model, c.robot.0, c.robot.1, k)));
-    if pts.len() > 1 {
-        let d: String = pts.iter().map(|(x, y)| format!("{x:.1},{y:.1} ")).collect();
-        let _ = write!(
-            s,
-            r##"<polyline points="{d}" fill="none" stroke="#1c7ed6" stroke-width="2" marker-end="url(#arrow)"/>"##
-        );
-    }
-    let (rx, ry) = (
+    let mut pts = vec![centre(before.robot.0, before.robot.1, k)];
+    pts.extend(steps.iter().map(|c| centre(c.robot.0, c.robot.1, k)));
+    g.polyline(&pts, &Style::outline(BLUE, 2.0).arrow_end("arrow"));
+    let at = [
         last.robot.0 as f64 * CELL + 2.0,
         last.robot.1 as f64 * CELL + 2.0,
-    );
+    ];
     let side = k as f64 * CELL - 4.0;
-    let _ = write!(
-        s,
-        r##"<rect x="{rx}" y="{ry}" width="{side}" height="{side}" rx="{}" fill="#1c7ed6" fill-opacity="0.8"/>"##,
-        side / 2.0
+    g.rect(
+        at,
+        [side, side],
+        &Style::new()
+            .fill(BLUE)
+            .fill_opacity(0.8)
+            .rounded(side / 2.0),
     );
 }
 
 /// Draw the plan as an SVG document of step panels.
 pub fn plan_svg(model: &Model, plan: &Plan) -> String {
-    let g = &model.problem.grid;
+    let grid = &model.problem.grid;
     let st = stages(plan);
     let panels = st.len().max(1);
     let cols = panels.min(3);
     let rows = panels.div_ceil(cols);
-    let pw = g.w as f64 * CELL + 2.0 * PAD;
-    let ph = g.h as f64 * CELL + 2.0 * PAD + 14.0;
-    let mut s = String::new();
-    let _ = write!(
-        s,
-        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{}" height="{}" font-family="sans-serif"><defs><marker id="arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="6" markerHeight="6" orient="auto-start-reverse"><path d="M0 0L10 5L0 10z" fill="#1c7ed6"/></marker></defs><rect width="100%" height="100%" fill="white"/>"##,
-        cols as f64 * pw,
-        rows as f64 * ph
-    );
+    let pw = grid.w as f64 * CELL + 2.0 * PAD;
+    let ph = grid.h as f64 * CELL + 2.0 * PAD + 14.0;
+    let mut d = Doc::new(cols as f64 * pw, rows as f64 * ph);
+    d.title(&model.problem.name);
+    d.arrow_marker("arrow", BLUE);
+    d.background(&Style::new().fill("white"));
     let mut before = plan.start.clone();
     if st.is_empty() {
-        let _ = write!(s, r#"<g transform="translate({PAD},{})">"#, PAD + 14.0);
-        panel(
-            &mut s,
-            model,
-            &before,
-            &[],
-            &format!("{}: already at the goal", model.problem.name),
-        );
-        s.push_str("</g>");
+        let mut g = Group::translated(PAD, PAD + 14.0);
+        let title = format!("{}: already at the goal", model.problem.name);
+        panel(&mut g, model, &before, &[], &title);
+        d.group(g);
     }
     for (n, range) in st.iter().enumerate() {
         let (col, row) = (n % cols, n / cols);
-        let _ = write!(
-            s,
-            r#"<g transform="translate({},{})">"#,
-            col as f64 * pw + PAD,
-            row as f64 * ph + PAD + 14.0
-        );
+        let mut g = Group::translated(col as f64 * pw + PAD, row as f64 * ph + PAD + 14.0);
         let cfgs: Vec<&Config> = plan.steps[range.clone()]
             .iter()
             .map(|p| &p.config)
@@ -193,12 +161,11 @@ pub fn plan_svg(model: &Model, plan: &Plan) -> String {
             range.len(),
             pushes
         );
-        panel(&mut s, model, &before, &cfgs, &title);
-        s.push_str("</g>");
+        panel(&mut g, model, &before, &cfgs, &title);
+        d.group(g);
         if let Some(c) = cfgs.last() {
             before = (*c).clone();
         }
     }
-    s.push_str("</svg>\n");
-    s
+    d.to_string()
 }
