@@ -115,12 +115,41 @@ mod tests {
         assert!(err.to_string().contains("/dev/null"));
     }
 
+    /// A pty opens raw (the frame delimiter 0x00, CR, LF and ^C pass unchanged both ways),
+    /// exclusive (a second open is refused as in use), and is free again after [`release`].
     #[test]
-    fn a_pty_opens() {
-        let (_master, slave) = TTYPort::pair().unwrap();
+    fn a_pty_opens_raw_and_exclusive() {
+        use std::io::{Read, Write};
+        let (mut master, slave) = TTYPort::pair().unwrap();
         let path = slave.name().unwrap();
         drop(slave);
         let mut port = open(&path).unwrap();
+        let mut buf = [0u8; 16];
+        let raw = [0x00, b'\r', b'\n', 0x03, 0x7f, 0xff];
+        port.write_all(&raw).unwrap();
+        port.flush().unwrap();
+        let mut got = Vec::new();
+        master.set_timeout(Duration::from_millis(200)).unwrap();
+        while got.len() < raw.len() {
+            let n = master.read(&mut buf).unwrap();
+            got.extend_from_slice(&buf[..n]);
+        }
+        assert_eq!(got, raw, "host → robot bytes changed on the way");
+        master.write_all(&raw).unwrap();
+        let mut back = Vec::new();
+        while back.len() < raw.len() {
+            let n = port.read(&mut buf).unwrap();
+            back.extend_from_slice(&buf[..n]);
+        }
+        assert_eq!(back, raw, "robot → host bytes changed on the way");
+        let second = open(&path).unwrap_err();
+        assert!(
+            second.to_string().contains("in use"),
+            "a second open was not refused as in use: {second}"
+        );
         release(&mut port);
+        drop(port);
+        let mut again = open(&path).expect("free again after release");
+        release(&mut again);
     }
 }
