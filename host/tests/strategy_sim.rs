@@ -6,6 +6,7 @@ use nalgebra::Vector2;
 use pushbot::exec::collect::{CollectParams, collect, reset_robot_obj_boundary, safe_spin};
 use pushbot::exec::deliver::{DeliveryParams, deliver_learned};
 use pushbot::experiments::strategy_eval::{Method, TrialSetup, run_start};
+use pushbot::sim::robot::{SimRobot, SimRobotOptions};
 use pushbot::strategy::regression::{KernelParams, PushStrategy};
 use pushbot::strategy::robot_io::RobotIo;
 use pushbot::strategy::sample::Sample;
@@ -96,9 +97,10 @@ fn learned_delivery_succeeds_from_two_starts_and_dipole_runs_beside_it() {
     for start in ["A", "C"] {
         let (res, runs) = run_start(&setup, Method::Learned, &samples, start, 1).unwrap();
         assert_eq!(res.successes, 1, "{start}: {res:?} {:?}", runs[0]);
-        // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees within 3σ.
+        // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees: the two
+        // looks differ by σ√2 per axis (σ = 1 mm), so within 3σ√2 ≈ 4.2 mm.
         assert!(
-            runs[0].final_distance < 0.025,
+            runs[0].final_distance < 0.022 + 0.0042,
             "{:?}",
             runs[0].final_distance
         );
@@ -311,7 +313,9 @@ fn an_object_against_the_edge_is_reported_not_slid_into_the_corner() {
 #[test]
 fn a_delivery_started_beside_the_boundary_stays_inside_it() {
     // A small strategy (the HIL test's 120 pushes) and start C, 5 cm inside the live boundary:
-    // its pushes drift sideways, and without the boundary guard the object leaves the boundary.
+    // its pushes drift sideways, and the boundary guard keeps the object inside. (Without the
+    // guard such a start loses the object over the edge in a few per cent of trials — 13 of 480
+    // in the README's sweep — too rare to show in the handful of trials a test can afford.)
     let scene = Scene::preset("lau-irregular").unwrap();
     let mut io = live_like(scene.clone(), 8);
     let mut strat = PushStrategy::new(Vec::new(), KernelParams::default());
@@ -324,6 +328,7 @@ fn a_delivery_started_beside_the_boundary_stays_inside_it() {
     )
     .unwrap();
     let samples = strat.samples().to_vec();
+    let ws_boundary = io.workspace().boundary;
     let setup = |delivery: DeliveryParams| TrialSetup {
         scene: scene.clone(),
         object: None,
@@ -336,19 +341,6 @@ fn a_delivery_started_beside_the_boundary_stays_inside_it() {
         delivery,
         kernel: KernelParams::default(),
     };
-    let unguarded = setup(DeliveryParams {
-        boundary_guard: 0.0,
-        ..DeliveryParams::default()
-    });
-    let (res, _) = run_start(&unguarded, Method::Learned, &samples, "C", 6).unwrap();
-    assert!(
-        res.failures
-            .get("object-left-boundary")
-            .copied()
-            .unwrap_or(0)
-            >= 3,
-        "without the guard: {res:?}"
-    );
     let (res, runs) = run_start(
         &setup(DeliveryParams::default()),
         Method::Learned,
@@ -358,9 +350,17 @@ fn a_delivery_started_beside_the_boundary_stays_inside_it() {
     )
     .unwrap();
     assert_eq!(res.successes, 6, "with the guard: {res:?}");
-    // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees within 3σ.
+    // The verdict saw the marker within 2.2 cm; one more (noisy) look agrees within 3σ√2.
     let finals: Vec<f64> = runs.iter().map(|d| d.final_distance).collect();
-    assert!(finals.iter().all(|&d| d < 0.022 + 0.003), "{finals:?}");
+    assert!(finals.iter().all(|&d| d < 0.022 + 0.0042), "{finals:?}");
+    // Every trial kept the object inside the boundary the whole way.
+    assert!(
+        runs.iter().all(|d| d
+            .trajectory
+            .iter()
+            .all(|(_, o)| ws_boundary.contains(o.position()))),
+        "the object left the boundary with the guard"
+    );
 }
 
 #[test]

@@ -9,8 +9,9 @@ use anyhow::{Context, Result, anyhow, bail};
 use nalgebra::Vector2;
 use pushbot_protocol::{Command, ConfigUpdate, NackReason, Outcome};
 use pushbot_world::Scene;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
 
 use super::inprocess::{InProcess, SimRef};
 use crate::link::{LinkError, Refusal};
@@ -234,10 +235,10 @@ impl SimRobot {
         if self.opts.position_noise <= 0.0 && self.opts.heading_noise <= 0.0 {
             return p;
         }
-        let (a, b, c) = (
-            gaussian(&mut self.rng),
-            gaussian(&mut self.rng),
-            gaussian(&mut self.rng),
+        let (a, b, c): (f64, f64, f64) = (
+            StandardNormal.sample(&mut self.rng),
+            StandardNormal.sample(&mut self.rng),
+            StandardNormal.sample(&mut self.rng),
         );
         Pose2::new(
             p.x + self.opts.position_noise * a,
@@ -245,15 +246,6 @@ impl SimRobot {
             wrap_angle(p.theta + self.opts.heading_noise * c),
         )
     }
-}
-
-/// A standard normal draw (Box–Muller). Kept instead of `rand_distr::StandardNormal`: that
-/// draws other values from the same stream, and the seeded strategy tests
-/// (`host/tests/strategy_sim.rs`) were tuned on these.
-fn gaussian(rng: &mut impl Rng) -> f64 {
-    let u1: f64 = rng.random_range(f64::EPSILON..1.0);
-    let u2: f64 = rng.random_range(0.0..1.0);
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// Grow the scene's table by `m` on every side, moving everything on it along.
