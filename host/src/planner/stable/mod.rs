@@ -11,9 +11,9 @@
 
 pub mod collision;
 pub mod exact;
-pub mod robot;
 pub mod presets;
 pub mod pusher;
+pub mod robot;
 pub mod search;
 pub mod svg;
 pub mod transit;
