@@ -3,7 +3,7 @@
 //! problem, and errors name the file, the line and the field.
 
 use pushbot::planner::rearrange::cases::load_scene;
-use pushbot::planner::rearrange::execute::{SceneOptions, scene_for};
+use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
 use pushbot::planner::rearrange::{Model, solve};
 
 fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> String {

@@ -4,9 +4,9 @@
 //! ([`pushbot::exec::LiveRobot`]); the simulator's ground truth judges where the boxes ended.
 
 use pushbot::exec::{LiveOptions, LiveRobot};
-use pushbot::planner::rearrange::execute::{
-    ExecOptions, GridFrame, SceneOptions, execute, scene_for,
-};
+use pushbot::exec::rearrange::{ExecOptions, execute};
+use pushbot::planner::rearrange::frame::GridFrame;
+use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
 use pushbot::planner::rearrange::{Model, cases::load_scene, cost_map};
 use pushbot::sim::SimTarget;
 use pushbot_tests::SIM_SPEED;

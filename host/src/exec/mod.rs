@@ -6,6 +6,7 @@
 //! - [`collect`]: Lau et al.'s Algorithm 1 (collecting the pushing strategy);
 //! - [`deliver`]: Algorithm 2 (learned delivery) and the dipole-field baseline;
 //! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals;
+//! - [`rearrange`]: Ben-Shahar & Rivlin's plans driven with re-observation and snapping;
 //! - [`stable`]: Lynch & Mason's stable pushes on the plated robot, with transits;
 //! - [`live`]: the [`RobotIo`](crate::strategy::robot_io::RobotIo) over a real serial link
 //!   and a real camera: the same code runs a robot on a table and the simulated target, which
@@ -17,6 +18,7 @@ pub mod deliver_path;
 pub mod grabber;
 pub mod live;
 pub mod maneuver;
+pub mod rearrange;
 pub mod record;
 pub mod stable;
 pub mod view;

@@ -322,7 +322,8 @@ fn stage_rearrange(
     case: &str,
     problem: &crate::planner::rearrange::Problem,
 ) -> Result<StageReport> {
-    use crate::planner::rearrange::execute::{ExecOptions, SceneOptions, execute, scene_for};
+    use crate::exec::rearrange::{ExecOptions, execute};
+    use crate::planner::rearrange::to_scene::{SceneOptions, scene_for};
     use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg};
 
     let mut st = StageReport::new(

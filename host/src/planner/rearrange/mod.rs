@@ -11,8 +11,9 @@
 //! - [`cases`]: the test cases A–D of §V-A (scene presets) and reading scenes;
 //! - [`scene`]: the shared scene format (`[rearrange]` section) rasterised to a grid problem;
 //! - [`svg`]: plans drawn as the paper's step-by-step figures;
-//! - [`frame`]: where the grid lies on the table, shared by [`scene`] and [`execute`];
-//! - [`execute`]: plans carried out by the robot on the table, closed on the camera (§V-B).
+//! - [`frame`]: where the grid lies on the table, shared by [`scene`] and [`to_scene`];
+//! - [`to_scene`]: a grid problem as a table scene (§V-B); `crate::exec::rearrange` carries
+//!   plans out on the robot, closed on the camera.
 //!
 //! Limits (§IV-E): the map holds one `u16` per packed configuration, so memory grows as
 //! (free cells)^(1 + r) — 128 MB for the robot and 2 boxes in a 20 × 20 room, 860 MB for 3 boxes in
@@ -25,7 +26,7 @@
 pub mod admissibility;
 pub mod cases;
 pub mod costmap;
-pub mod execute;
+
 pub mod frame;
 pub mod grid;
 pub mod metric;
@@ -33,6 +34,7 @@ pub mod problem;
 pub mod restore;
 pub mod scene;
 pub mod svg;
+pub mod to_scene;
 
 pub use admissibility::{MoveKind, Step};
 pub use costmap::{CostMap, INF, MapError, MapStats, cost_map};
