@@ -5,12 +5,12 @@
 //! grid and goes on by restoration from the same cost map.
 
 use anyhow::Result;
+use pushbot::exec::io::{RobotIo, Workspace};
 use pushbot::exec::rearrange::{ExecOptions, ExecReport, execute};
 use pushbot::planner::rearrange::frame::GridFrame;
 use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
 use pushbot::planner::rearrange::{CostMap, Model, Problem, cases::load_scene, cost_map};
 use pushbot::sim::robot::{SimRobot, SimRobotOptions};
-use pushbot::strategy::robot_io::{RobotIo, Workspace};
 use pushbot::strategy::sample::Pose2;
 
 fn setup(case: &str, noise: bool, seed: u64) -> (Problem, Model, CostMap, SimRobot) {

@@ -11,6 +11,7 @@
 //! closed loop between primitives, aimed from the observed poses) and comes back flush onto the
 //! new edge, and the pushes on both edges must keep the slider on the plate.
 
+use pushbot::exec::io::RobotIo;
 use pushbot::exec::stable::{PushRecord, contact_changes, execute as run_plan};
 use pushbot::mechanics::V3;
 use pushbot::planner::stable::exact::finish_exactly;
@@ -19,7 +20,6 @@ use pushbot::planner::stable::robot::{
 };
 use pushbot::planner::stable::{Plan, Pose, Problem, angle_diff, plan};
 use pushbot::sim::robot::{SimRobot, SimRobotOptions};
-use pushbot::strategy::robot_io::RobotIo;
 
 /// The preset `name` for the plated robot (edge 0 only) with the goal heading tolerance of
 /// `goal_theta_deg`.

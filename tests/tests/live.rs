@@ -2,9 +2,9 @@
 //! serial link on the sim's pty and the real vision pipeline on the sim's camera socket
 //! ([`pushbot::exec::LiveRobot`]), judged by the simulator's ground truth.
 
+use pushbot::exec::io::RobotIo;
 use pushbot::exec::{LiveOptions, LiveRobot};
 use pushbot::sim::SimTarget;
-use pushbot::strategy::robot_io::RobotIo;
 use pushbot_sim::Scene;
 use pushbot_tests::{SIM_SPEED, angle_diff};
 

@@ -6,7 +6,8 @@
 //! * [`body`] — the robot's build (round bumper, front plate, switches);
 //! * [`scene`] — the one scene format (TOML), its validation with file:line:col errors, and
 //!   [`presets`];
-//! * [`camera`] — the camera model and the markers it sees.
+//! * [`camera`] — the camera model and the markers it sees;
+//! * [`workspace`] — the table and the boundary of a delivery (Lau et al. §III-A).
 //!
 //! The table frame has its origin at the table's lower-left corner, x along the width, y along
 //! the height, angles counter-clockwise from +x. This crate depends on neither the firmware nor
@@ -21,6 +22,7 @@ pub mod polygon;
 pub mod pose;
 pub mod presets;
 pub mod scene;
+pub mod workspace;
 
 pub use pose::{Pose, wrap_angle};
 pub use scene::{Scene, SceneError};

@@ -23,9 +23,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::exec::deliver::{DeliveryParams, Failure, bound_all_radius, deliver_learned};
+use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{Turn, circle_walk, face};
 use crate::strategy::regression::PushStrategy;
-use crate::strategy::robot_io::RobotIo;
 use crate::strategy::sample::Sample;
 
 /// Parameters of Algorithm 1.
@@ -282,7 +282,7 @@ fn stuck(io: &mut dyn RobotIo) -> anyhow::Error {
 }
 
 /// How far `p` lies outside `r`, m (0 inside).
-fn distance_outside(r: &crate::strategy::robot_io::Rect, p: Vector2<f64>) -> f64 {
+fn distance_outside(r: &crate::exec::io::Rect, p: Vector2<f64>) -> f64 {
     let dx = (r.min[0] - p.x).max(p.x - r.max[0]).max(0.0);
     let dy = (r.min[1] - p.y).max(p.y - r.max[1]).max(0.0);
     dx.hypot(dy)

@@ -15,11 +15,11 @@
 use anyhow::Result;
 use nalgebra::Vector2;
 
+use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::exec::maneuver::{Drive, Turn, angle_of, circle_walk, face, go_to};
 use crate::planner::global::robot_fits;
 use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
 use crate::strategy::regression::{PushStrategy, Reposition};
-use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
 use crate::strategy::sample::{Pose2, Sample};
 
 /// Parameters of delivery.

@@ -8,9 +8,9 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use crate::exec::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};
+use crate::exec::io::RobotIo;
 use crate::planner::global::{ObstacleParams, plan_object_path, point_along};
 use crate::strategy::regression::PushStrategy;
-use crate::strategy::robot_io::RobotIo;
 use crate::strategy::sample::Sample;
 
 /// How a delivery among obstacles went.

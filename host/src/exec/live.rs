@@ -17,8 +17,8 @@ use pushbot_protocol::Outcome;
 use pushbot_world::Scene;
 
 use super::grabber::FrameGrabber;
+use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::robot::{LinkOptions, Robot};
-use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
 use crate::strategy::sample::Pose2;
 use crate::vision::Pipeline;
 use crate::vision::calibration::Calibration;

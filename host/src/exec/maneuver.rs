@@ -8,8 +8,8 @@
 use anyhow::Result;
 use nalgebra::Vector2;
 
+use crate::exec::io::RobotIo;
 use crate::planner::global::robot_fits;
-use crate::strategy::robot_io::RobotIo;
 use crate::strategy::sample::{Pose2, wrap_angle};
 
 /// How to turn to a heading: up to `tries` spins, each from a fresh measurement, stopping once

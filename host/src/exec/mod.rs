@@ -1,6 +1,6 @@
 //! Execution: the host's end of the closed loop (camera → tracking → decision → motion
 //! primitive → link → firmware → motors). Each executor runs *look → estimate → plan or correct
-//! → act* on a [`RobotIo`](crate::strategy::robot_io::RobotIo), with the maneuvers written once
+//! → act* on a [`RobotIo`](crate::exec::io::RobotIo), with the maneuvers written once
 //! in [`maneuver`]:
 //!
 //! - [`collect`]: Lau et al.'s Algorithm 1 (collecting the pushing strategy);
@@ -8,7 +8,7 @@
 //! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals;
 //! - [`rearrange`]: Ben-Shahar & Rivlin's plans driven with re-observation and snapping;
 //! - [`stable`]: Lynch & Mason's stable pushes on the plated robot, with transits;
-//! - [`live`]: the [`RobotIo`](crate::strategy::robot_io::RobotIo) over a real serial link
+//! - [`live`]: the [`RobotIo`](crate::exec::io::RobotIo) over a real serial link
 //!   and a real camera: the same code runs a robot on a table and the simulated target, which
 //!   it cannot tell apart.
 
@@ -16,6 +16,7 @@ pub mod collect;
 pub mod deliver;
 pub mod deliver_path;
 pub mod grabber;
+pub mod io;
 pub mod live;
 pub mod maneuver;
 pub mod rearrange;

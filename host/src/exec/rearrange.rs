@@ -14,13 +14,13 @@ use std::f64::consts::FRAC_PI_2;
 use anyhow::{Context, Result, anyhow, bail};
 use nalgebra::Vector2;
 
+use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{self, Drive, Turn};
 use crate::planner::rearrange::admissibility::MoveKind;
 use crate::planner::rearrange::costmap::CostMap;
 use crate::planner::rearrange::frame::GridFrame;
 use crate::planner::rearrange::problem::{Config, Dir, Model, Placement};
 use crate::planner::rearrange::restore::restore;
-use crate::strategy::robot_io::RobotIo;
 
 /// Settings of the executor.
 #[derive(Debug, Clone, Copy, PartialEq)]

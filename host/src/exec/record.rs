@@ -5,7 +5,7 @@
 use anyhow::Result;
 use serde::Serialize;
 
-use crate::strategy::robot_io::{RobotIo, Workspace};
+use crate::exec::io::{RobotIo, Workspace};
 use crate::strategy::sample::Pose2;
 
 /// One recorded instant: after a primitive (or at the start).

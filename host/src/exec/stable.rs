@@ -15,12 +15,12 @@
 
 use anyhow::{Context, Result, anyhow, bail};
 
+use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{Drive, Turn, face, go_to};
 use crate::mechanics::{V2, cross};
 use crate::planner::stable::robot::{SPEED, arcs, robot_in_slider};
 use crate::planner::stable::transit::TransitPath;
 use crate::planner::stable::{Plan, Pose, Problem, angle_diff};
-use crate::strategy::robot_io::RobotIo;
 
 /// One executed push: the slider's pose relative to the robot before and after, and how far
 /// the slider moved.
@@ -258,10 +258,10 @@ pub fn approach(p: &Problem, ci: usize, io: &mut dyn RobotIo) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::exec::io::{Rect, Workspace};
     use crate::planner::stable::robot::{robot_problem, robot_problem_edges};
     use crate::planner::stable::search::Step;
     use crate::planner::stable::transit::{point_segment_distance, transit};
-    use crate::strategy::robot_io::{Rect, Workspace};
     use crate::strategy::sample::Pose2;
 
     /// A kinematic robot: its primitives move it exactly, or with the given errors (spins

@@ -10,10 +10,10 @@ pub use super::trials::{Method, StartResult, parse_starts, summarise};
 use crate::exec::collect::CollectReport;
 use crate::exec::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use crate::exec::deliver_path::deliver_among_obstacles;
+use crate::exec::io::RobotIo;
 use crate::planner::global::{ObstacleParams, scene_obstacles};
 use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::regression::{KernelParams, PushStrategy};
-use crate::strategy::robot_io::RobotIo;
 use crate::strategy::sample::{Pose2, Sample};
 
 /// Everything a batch of trials needs.

@@ -17,7 +17,7 @@ use nalgebra::Vector2;
 use pathfinding::prelude::astar;
 use pushbot_world::Scene;
 
-use crate::strategy::robot_io::Workspace;
+use pushbot_world::workspace::Workspace;
 
 /// Parameters of the global path and its sub-goals.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -237,7 +237,7 @@ pub fn scene_goal(scene: &Scene, object: Option<&str>) -> Result<Vector2<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::strategy::robot_io::Rect;
+    use pushbot_world::workspace::Rect;
 
     fn ws() -> Workspace {
         Workspace {

@@ -14,9 +14,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
 use super::inprocess::{InProcess, SimRef};
+use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::link::{LinkError, Refusal};
 use crate::robot::{LinkOptions, Robot};
-use crate::strategy::robot_io::{Rect, RobotIo, Workspace};
 use crate::strategy::sample::{Pose2, wrap_angle};
 
 /// Settings of the in-process robot.

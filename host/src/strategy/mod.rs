@@ -16,6 +16,6 @@ pub mod bench;
 pub mod dipole;
 pub mod figures;
 pub mod regression;
-pub mod robot_io;
+
 pub mod sample;
 pub mod store;

@@ -1,16 +1,8 @@
-//! "The robot and what the camera sees": the few primitives and observations that the pushing
-//! strategy's collection (Lau, Mitani & Igarashi §III-C/D, Algorithm 1) and delivery (§III-E,
-//! Algorithm 2) are written against. Its in-process implementation on the simulated robot is
-//! `crate::sim::robot::SimRobot`; the one on a robot behind a serial port is
-//! `crate::exec::live::LiveRobot`.
-//!
-//! The paper's robot only spins, drives forward and stops (§IV, "Software"); its host sees the
-//! robot's and the object's marker poses from a ceiling camera. [`RobotIo`] is exactly that.
+//! The workspace of a delivery as Lau, Mitani & Igarashi define it (§III-A): the table the
+//! robot drives on, the boundary the object must stay inside, the robot's radius and the radius
+//! of the object's bounding circle; axis-aligned rectangles of the table frame.
 
-use anyhow::Result;
 use nalgebra::Vector2;
-
-use super::sample::Pose2;
 
 /// An axis-aligned rectangle of the table frame, m.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -80,25 +72,4 @@ impl Workspace {
     pub fn reachable(&self) -> Rect {
         self.table.inset(self.robot_radius + 0.01)
     }
-}
-
-/// The robot and the camera, as the strategy code sees them.
-pub trait RobotIo {
-    /// Spin in place by `angle`, rad (counter-clockwise positive); returns when stopped.
-    fn spin(&mut self, angle: f64) -> Result<()>;
-    /// Drive straight by `distance`, m (negative: backwards); returns when stopped.
-    fn forward(&mut self, distance: f64) -> Result<()>;
-    /// Drive at `v` m/s turning at `omega` rad/s for `duration` s (the dipole baseline).
-    fn drive(&mut self, v: f64, omega: f64, duration: f64) -> Result<()>;
-    /// The robot's pose in the table frame, as the camera sees it.
-    fn robot_pose(&mut self) -> Pose2;
-    /// The object's marker pose in the table frame, as the camera sees it.
-    fn object_pose(&mut self) -> Pose2;
-    /// The pose of the object named `id` in the scene (its body frame, not its marker), in the
-    /// table frame, as the camera sees it; `None` when there is no such object or it is not seen.
-    fn body_pose(&mut self, id: &str) -> Option<Pose2>;
-    /// Time since the start, s (simulated time in simulation).
-    fn time(&self) -> f64;
-    /// The workspace.
-    fn workspace(&self) -> Workspace;
 }
