@@ -16,6 +16,7 @@ pub mod robot;
 pub mod scene;
 pub mod stable;
 pub mod strategy;
+pub mod strategy_args;
 #[cfg(feature = "sim")]
 mod strategy_sim;
 pub mod vision;
@@ -58,9 +59,9 @@ pub enum Command {
     #[command(subcommand)]
     Plan(PlanCommand),
     /// Collect a pushing strategy for an object (Lau et al. Algorithm 1), in simulation.
-    Collect(strategy::CollectArgs),
+    Collect(strategy_args::CollectArgs),
     /// Evaluate: `eval delivery` (Lau et al. Fig. 11, learned vs dipole).
-    Eval(strategy::EvalArgs),
+    Eval(strategy_args::EvalArgs),
     /// Calibrate the overhead camera from markers at known table positions.
     Calibrate(vision::CalibrateArgs),
     /// Track the robot, objects and goals with the overhead camera (one line per frame).
@@ -92,7 +93,7 @@ pub enum BenchCommand {
     #[command(flatten)]
     Vision(vision::BenchCommand),
     #[command(flatten)]
-    Strategy(strategy::BenchCmd),
+    Strategy(strategy_args::BenchCmd),
 }
 
 /// How a command that ran to its end went.
@@ -321,7 +322,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Track(a) => vision::track(&global, a),
         Command::Bench(BenchCommand::Vision(b)) => vision::bench(&global, b),
         Command::Bench(BenchCommand::Strategy(cmd)) => {
-            strategy::run_bench(&global, strategy::BenchArgs { cmd })
+            strategy::run_bench(&global, strategy_args::BenchArgs { cmd })
         }
         Command::Collect(args) => strategy::run_collect(&global, args),
         Command::Eval(args) => strategy::run_eval(&global, args),

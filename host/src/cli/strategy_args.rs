@@ -1,0 +1,224 @@
+//! The arguments of `pushbot collect`, `pushbot eval delivery` and `pushbot bench knn` (the
+//! learned pushing strategy of Lau, Mitani & Igarashi), shared by the commands that run on a
+//! robot ([`super::strategy`]) and those that run in the simulation (`strategy_sim`).
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::{CliError, Global};
+use crate::exec::deliver::DeliveryParams;
+use crate::strategy::regression::KernelParams;
+
+/// Settings shared by collection and evaluation.
+#[derive(Args, Debug, Clone)]
+pub struct SimArgs {
+    /// Camera position noise (standard deviation), mm.
+    #[arg(long, default_value_t = 1.0)]
+    pub noise_mm: f64,
+    /// Camera heading noise (standard deviation), degrees.
+    #[arg(long, default_value_t = 0.5)]
+    pub noise_deg: f64,
+    /// How far inside the table edge the object's boundary lies, m [default: 0.1 in simulation,
+    /// whose table gets --table-margin of extra room; 0.2 with --hil, where the table is the
+    /// real one and the robot needs room to get behind an object at the boundary]
+    #[arg(long)]
+    pub boundary_inset: Option<f64>,
+    /// Extra simulated table beyond the scene's on every side (room for the robot), m.
+    #[arg(long, default_value_t = 0.25)]
+    pub table_margin: f64,
+    /// Kernel width K_w of the regression, m (the paper: 8 px ≈ 1.8 cm).
+    #[arg(long, default_value_t = 0.018)]
+    pub kernel_width: f64,
+    /// Neighbours k of the regression.
+    #[arg(long, default_value_t = 5)]
+    pub k: usize,
+}
+
+impl SimArgs {
+    pub fn kernel(&self) -> Result<KernelParams, CliError> {
+        if !(self.kernel_width.is_finite() && self.kernel_width > 0.0) || self.k == 0 {
+            return Err(CliError::bad_input(
+                "the kernel width must be positive and k at least 1",
+            ));
+        }
+        Ok(KernelParams {
+            k: self.k,
+            kernel_width: self.kernel_width,
+        })
+    }
+}
+
+/// `pushbot collect`: collect a pushing strategy (Algorithm 1) in the simulation.
+#[derive(Args, Debug)]
+pub struct CollectArgs {
+    /// The object: one of Lau et al.'s six (irregular, irregular-corner, l-shape, wire-cutter,
+    /// scissors, snake; scene `lau-<object>`), or an object id of `--scene`.
+    #[arg(long)]
+    pub object: String,
+    /// Scene preset or file (default: `lau-<object>`).
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// Strategy file to append to (default: `<object>.strategy`); an existing file is resumed.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// K: samples of the initial collection.
+    #[arg(long, default_value_t = 300)]
+    pub initial: usize,
+    /// Stop the evaluation after this many straight successful queries.
+    #[arg(long, default_value_t = 10)]
+    pub streak: usize,
+    /// Give up the evaluation after this many queries.
+    #[arg(long, default_value_t = 80)]
+    pub max_queries: usize,
+    /// Write the strategy as an SVG (Fig. 7 style).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub sim: SimArgs,
+}
+
+/// `pushbot eval`: evaluations.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// What to evaluate.
+    #[command(subcommand)]
+    pub cmd: EvalCmd,
+}
+
+/// The evaluations.
+#[derive(Subcommand, Debug)]
+pub enum EvalCmd {
+    /// Deliver the object from named start positions to the goal (Lau et al. Fig. 10–11).
+    Delivery(DeliveryArgs),
+}
+
+/// Which delivery methods to run.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MethodArg {
+    /// The learned pushing strategy.
+    Learned,
+    /// The dipole-field baseline.
+    Dipole,
+    /// Both, side by side.
+    Both,
+}
+
+/// `pushbot eval delivery`.
+#[derive(Args, Debug)]
+pub struct DeliveryArgs {
+    /// Learned delivery's boundary guard: the band inside the boundary where the wanted object
+    /// motion is pulled inward and pushes are shortened, m; 0 is the paper's delivery, which
+    /// only fails once the object crosses the boundary [default: 0.06]
+    #[arg(long)]
+    pub boundary_guard: Option<f64>,
+    /// Scene preset or file (e.g. lau-irregular), several separated by commas, or `lau-all`
+    /// for the six objects of Lau et al.; scenes with obstacles are delivered along a global
+    /// path (learned method).
+    #[arg(long)]
+    pub scene: String,
+    /// Object id in the scene (default: the first).
+    #[arg(long)]
+    pub object: Option<String>,
+    /// Method(s).
+    #[arg(long, value_enum, default_value_t = MethodArg::Both)]
+    pub method: MethodArg,
+    /// Start positions: A..F, A,C or B.
+    #[arg(long, default_value = "A..F")]
+    pub start: String,
+    /// Trials per start position and method.
+    #[arg(long, default_value_t = 10)]
+    pub trials: usize,
+    /// Pushing strategy file (one scene); without it or `--strategy-dir` one is collected in
+    /// the simulation first.
+    #[arg(long)]
+    pub strategy: Option<PathBuf>,
+    /// Directory of cached strategies `<scene>.strategy`: loaded when present, otherwise
+    /// collected (Algorithm 1, initial + evaluation) and written there.
+    #[arg(long)]
+    pub strategy_dir: Option<PathBuf>,
+    /// K of the collection when no strategy file is given.
+    #[arg(long, default_value_t = 300)]
+    pub initial: usize,
+    /// Time limit of one trial, s of simulated time (the paper: 8 minutes).
+    #[arg(long, default_value_t = 480.0)]
+    pub time_limit: f64,
+    /// Run on the robot through the serial port and the camera (`--port`, `--camera`): collect
+    /// (unless `--strategy`) and deliver the one live object from where it is to the goal,
+    /// `--trials` times, with one `--method`.
+    #[arg(long)]
+    pub hil: bool,
+    /// With `--hil`: the robot's serial port.
+    #[arg(long)]
+    pub port: Option<String>,
+    /// With `--hil`: the camera (a device, an image folder, a video, or `sim:HOST:PORT`).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// With `--hil`: the robot's link watchdog, ms of robot time.
+    #[arg(long, default_value_t = 1000)]
+    pub watchdog_ms: u16,
+    /// Collection's evaluation stops after this many straight successful queries (0: initial
+    /// collection only).
+    #[arg(long, default_value_t = 10)]
+    pub streak: usize,
+    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub sim: SimArgs,
+}
+
+/// `pushbot bench`: benchmarks.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Which benchmark.
+    #[command(subcommand)]
+    pub cmd: BenchCmd,
+}
+
+/// The benchmarks of this module.
+#[derive(Subcommand, Debug)]
+pub enum BenchCmd {
+    /// k-NN regression query time at a strategy size.
+    Knn {
+        /// Samples in the strategy.
+        #[arg(long, default_value_t = 100_000)]
+        samples: usize,
+        /// Queries timed.
+        #[arg(long, default_value_t = 2_000)]
+        queries: usize,
+    },
+}
+
+pub fn progress_bar(global: &Global, len: u64) -> ProgressBar {
+    if global.json || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{elapsed_precise} samples {pos} {wide_bar} {msg}")
+    {
+        pb.set_style(style);
+    }
+    pb
+}
+
+impl DeliveryArgs {
+    /// The delivery parameters these arguments set (time limit, boundary guard).
+    pub fn delivery_params(&self) -> Result<DeliveryParams, CliError> {
+        let d = DeliveryParams::default();
+        let boundary_guard = self.boundary_guard.unwrap_or(d.boundary_guard);
+        if !(boundary_guard.is_finite() && boundary_guard >= 0.0) {
+            return Err(CliError::bad_input(
+                "--boundary-guard must be finite and not negative",
+            ));
+        }
+        Ok(DeliveryParams {
+            time_limit: self.time_limit,
+            boundary_guard,
+            ..d
+        })
+    }
+}
