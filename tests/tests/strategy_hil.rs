@@ -4,7 +4,7 @@
 
 use clap::Parser;
 use pushbot::cli::{Cli, Status, run};
-use pushbot::exec::SimTarget;
+use pushbot::sim::SimTarget;
 use pushbot_sim::Scene;
 use pushbot_tests::SIM_SPEED;
 
