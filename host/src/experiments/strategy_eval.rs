@@ -186,6 +186,9 @@ pub fn fig11_table(evals: &[SceneEval], starts: &[String], methods: &[Method]) -
     t
 }
 
+/// One trial's robot and object poses after every step, labelled "START METHOD".
+pub type LabelledRun = (String, Vec<(Pose2, Pose2)>);
+
 /// Trials of every method from every start of one scene (Lau et al. §V): the results, in the
 /// order start × method, each handed to `report` as it is done, and the first trial's
 /// trajectory of each (labelled "START METHOD") for the figure.
@@ -196,7 +199,7 @@ pub fn evaluate_scene(
     starts: &[String],
     trials: usize,
     report: &mut dyn FnMut(&StartResult),
-) -> Result<(Vec<StartResult>, Vec<(String, Vec<(Pose2, Pose2)>)>)> {
+) -> Result<(Vec<StartResult>, Vec<LabelledRun>)> {
     let mut results = Vec::new();
     let mut trajectories = Vec::new();
     for s in starts {
