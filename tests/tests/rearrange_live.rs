@@ -3,8 +3,8 @@
 //! observes the boxes through the real vision pipeline on the sim's camera
 //! ([`pushbot::exec::LiveRobot`]); the simulator's ground truth judges where the boxes ended.
 
-use pushbot::exec::{LiveOptions, LiveRobot};
 use pushbot::exec::rearrange::{ExecOptions, execute};
+use pushbot::exec::{LiveOptions, LiveRobot};
 use pushbot::planner::rearrange::frame::GridFrame;
 use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
 use pushbot::planner::rearrange::{Model, cases::load_scene, cost_map};
