@@ -242,31 +242,31 @@ fn exact_goal_finishes_a_car_plan_and_says_clearly_when_nothing_finishes() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["found"], true, "{v}");
     assert_eq!(v["exact_goal"], true, "{v}");
-    // Fig. 16's slot with the goal moved 5 mm into the right-hand obstacle: the goal
-    // neighbourhood (±2 cm) has free room, so a plan is found, but no push can end exactly
-    // on the goal. A failure (exit 1) with the reason, as JSON on stdout.
+    // Fig. 16's slot with the goal moved 5 mm into the right-hand obstacle: such a goal is
+    // refused when the scene is read (issue 18), naming the goal, the obstacle and where the
+    // goal is written — before any planning, with or without --exact-goal.
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = dir.path().join("fig16-wall.toml");
     std::fs::write(&scene, FIG16_GOAL_IN_WALL).expect("write scene");
-    let out = run(scene.to_str().expect("UTF-8 path"));
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    assert!(
-        v["error"]["message"]
-            .as_str()
-            .is_some_and(|m| m.contains("no exact finish")
-                && m.contains("goal configuration itself is not free")),
-        "{v}"
-    );
-    // Without --exact-goal the same scene plans into the neighbourhood.
-    let out = std::process::Command::new(pushbot_tests::bin("pushbot"))
-        .args(["--json", "plan", "stable", "--scene"])
-        .arg(&scene)
-        .output()
-        .expect("run pushbot");
-    assert!(out.status.success(), "{out:?}");
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    assert_eq!(v["found"], true, "{v}");
+    for exact in [true, false] {
+        let mut cmd = std::process::Command::new(pushbot_tests::bin("pushbot"));
+        cmd.args(["--json", "plan", "stable", "--scene"])
+            .arg(&scene);
+        if exact {
+            cmd.arg("--exact-goal");
+        }
+        let out = cmd.output().expect("run pushbot");
+        assert_eq!(out.status.code(), Some(2), "{out:?}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        assert!(
+            v["error"]["message"]
+                .as_str()
+                .is_some_and(|m| m.contains("fig16-wall.toml:")
+                    && m.contains("goals[0]")
+                    && m.contains("inside obstacles[1]")),
+            "{v}"
+        );
+    }
 }
 
 /// Fig. 16's scene with the goal 11.2 cm right of the slot's centre: at the goal's heading
