@@ -1,11 +1,9 @@
 //! Link faults between the host and the simulated robot, both directions, seeded: dropped
-//! bytes, corrupted bytes (one random bit flipped), delayed bursts (order kept), and periodic
-//! link cuts during which every byte is lost. Times are simulated time.
+//! bytes, corrupted bytes (one random bit flipped), inserted garbage, lost and duplicated
+//! frames, delayed bursts (order kept), and link cuts during which every byte is lost. Times
+//! are simulated time. Each direction is a sans-IO [`FaultPipe`] (`crate::fault_pipe`).
 
-use std::collections::VecDeque;
-
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+pub use crate::fault_pipe::{FaultPipe, PipeStats};
 
 /// What goes wrong on the link, and how often.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -14,6 +12,12 @@ pub struct LinkFaults {
     pub drop: f64,
     /// Probability that a byte has one bit flipped.
     pub corrupt: f64,
+    /// Probability that a random byte is inserted before a byte.
+    pub garbage: f64,
+    /// Probability that a whole frame (up to its `0x00` delimiter) is lost.
+    pub frame_loss: f64,
+    /// Probability that a frame is delivered twice.
+    pub duplicate: f64,
     /// Each burst of bytes is held for a delay drawn uniformly from 0..=`max_delay_us`.
     pub max_delay_us: u64,
     /// The link is cut for `cut_for_us` at the end of every `cut_every_us` (0 = never).
@@ -29,6 +33,9 @@ impl Default for LinkFaults {
         LinkFaults {
             drop: 1e-3,
             corrupt: 1e-3,
+            garbage: 0.0,
+            frame_loss: 0.0,
+            duplicate: 0.0,
             max_delay_us: 20_000,
             cut_every_us: 10_000_000,
             cut_for_us: 300_000,
@@ -45,105 +52,51 @@ impl LinkFaults {
     }
 }
 
-/// One direction of a faulty link.
-#[derive(Clone, Debug)]
-struct Direction {
-    queue: VecDeque<(u64, u8)>,
-    last_due: u64,
-}
-
-/// Both directions of a faulty link.
+/// Both directions of a faulty link: one [`FaultPipe`] each, on their own streams of the seed.
 #[derive(Clone, Debug)]
 pub struct FaultyLink {
-    cfg: LinkFaults,
-    rng: ChaCha8Rng,
-    to_robot: Direction,
-    to_host: Direction,
-    /// Bytes lost so far (dropped or cut).
-    pub dropped: u64,
-    /// Bytes corrupted so far.
-    pub corrupted: u64,
+    to_robot: FaultPipe,
+    to_host: FaultPipe,
 }
 
 impl FaultyLink {
-    /// A link with these faults, drawing from `seed` (its own stream).
+    /// A link with these faults, drawing from `seed` (streams of their own).
     pub fn new(cfg: LinkFaults, seed: u64) -> Self {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        rng.set_stream(2);
-        let d = || Direction {
-            queue: VecDeque::new(),
-            last_due: 0,
-        };
         FaultyLink {
-            cfg,
-            rng,
-            to_robot: d(),
-            to_host: d(),
-            dropped: 0,
-            corrupted: 0,
+            to_robot: FaultPipe::new(cfg, seed, 2),
+            to_host: FaultPipe::new(cfg, seed, 3),
         }
     }
 
     /// Bytes the host sent at `now_us`.
     pub fn from_host(&mut self, now_us: u64, bytes: &[u8]) {
-        self.enqueue(true, now_us, bytes);
+        self.to_robot.push(now_us, bytes);
     }
 
     /// Bytes the robot sent at `now_us`.
     pub fn from_robot(&mut self, now_us: u64, bytes: &[u8]) {
-        self.enqueue(false, now_us, bytes);
+        self.to_host.push(now_us, bytes);
     }
 
     /// Bytes that reach the robot by `now_us`.
     pub fn to_robot(&mut self, now_us: u64, out: &mut Vec<u8>) {
-        deliver(&mut self.to_robot, now_us, out);
+        self.to_robot.pull(now_us, out);
     }
 
     /// Bytes that reach the host by `now_us`.
     pub fn to_host(&mut self, now_us: u64, out: &mut Vec<u8>) {
-        deliver(&mut self.to_host, now_us, out);
+        self.to_host.pull(now_us, out);
     }
 
-    fn enqueue(&mut self, to_robot: bool, now_us: u64, bytes: &[u8]) {
-        if bytes.is_empty() {
-            return;
-        }
-        let delay = if self.cfg.max_delay_us > 0 {
-            self.rng.random_range(0..=self.cfg.max_delay_us)
-        } else {
-            0
-        };
-        let cut = self.cfg.cut(now_us);
-        let dir = if to_robot {
-            &mut self.to_robot
-        } else {
-            &mut self.to_host
-        };
-        // Keep the order: a burst never overtakes the one before.
-        let due = (now_us + delay).max(dir.last_due);
-        dir.last_due = due;
-        for &b in bytes {
-            if cut || (self.cfg.drop > 0.0 && self.rng.random_bool(self.cfg.drop.min(1.0))) {
-                self.dropped += 1;
-                continue;
-            }
-            let mut b = b;
-            if self.cfg.corrupt > 0.0 && self.rng.random_bool(self.cfg.corrupt.min(1.0)) {
-                b ^= 1 << self.rng.random_range(0..8);
-                self.corrupted += 1;
-            }
-            dir.queue.push_back((due, b));
-        }
+    /// Cut both directions from `now_us` for `len_us`.
+    pub fn cut_for(&mut self, now_us: u64, len_us: u64) {
+        self.to_robot.cut_for(now_us, len_us);
+        self.to_host.cut_for(now_us, len_us);
     }
-}
 
-fn deliver(dir: &mut Direction, now_us: u64, out: &mut Vec<u8>) {
-    while let Some(&(due, b)) = dir.queue.front() {
-        if due > now_us {
-            break;
-        }
-        out.push(b);
-        dir.queue.pop_front();
+    /// What each direction did so far: (host → robot, robot → host).
+    pub fn stats(&self) -> (PipeStats, PipeStats) {
+        (self.to_robot.stats(), self.to_host.stats())
     }
 }
 
@@ -158,6 +111,9 @@ mod tests {
         let none = LinkFaults {
             drop: 0.0,
             corrupt: 0.0,
+            garbage: 0.0,
+            frame_loss: 0.0,
+            duplicate: 0.0,
             max_delay_us: 0,
             cut_every_us: 0,
             cut_for_us: 0,
@@ -177,7 +133,7 @@ mod tests {
         l.to_host(100, &mut out);
         let lost = 25_600 - out.len();
         assert!((2_000..3_200).contains(&lost), "{lost}");
-        assert_eq!(l.dropped as usize, lost);
+        assert_eq!(l.stats().1.dropped as usize, lost);
 
         let cut = LinkFaults {
             cut_every_us: 1000,

@@ -14,6 +14,7 @@
 pub use pushbot_world::{geometry, presets, scene};
 
 pub mod encoder;
+pub mod fault_pipe;
 pub mod faults;
 pub mod motor;
 pub mod pty;

@@ -67,6 +67,15 @@ struct Cli {
     /// With --faults: probability that a byte has a bit flipped.
     #[arg(long, value_name = "P", requires = "faults")]
     fault_corrupt: Option<f64>,
+    /// With --faults: probability that a random byte is inserted before a byte (garbage).
+    #[arg(long, value_name = "P", requires = "faults")]
+    fault_garbage: Option<f64>,
+    /// With --faults: probability that a whole frame (up to its 0x00 delimiter) is lost.
+    #[arg(long, value_name = "P", requires = "faults")]
+    fault_frame_loss: Option<f64>,
+    /// With --faults: probability that a frame is delivered twice.
+    #[arg(long, value_name = "P", requires = "faults")]
+    fault_duplicate: Option<f64>,
     /// With --faults: longest delay of a burst of bytes, ms.
     #[arg(long, value_name = "MS", requires = "faults")]
     fault_delay_ms: Option<f64>,
@@ -261,6 +270,9 @@ fn run(cli: Cli) -> Result<()> {
         };
         f.drop = prob("fault-drop", cli.fault_drop, f.drop)?;
         f.corrupt = prob("fault-corrupt", cli.fault_corrupt, f.corrupt)?;
+        f.garbage = prob("fault-garbage", cli.fault_garbage, f.garbage)?;
+        f.frame_loss = prob("fault-frame-loss", cli.fault_frame_loss, f.frame_loss)?;
+        f.duplicate = prob("fault-duplicate", cli.fault_duplicate, f.duplicate)?;
         f.max_delay_us = dur("fault-delay-ms", cli.fault_delay_ms, 1e3, f.max_delay_us)?;
         f.cut_every_us = dur("fault-cut-every", cli.fault_cut_every, 1e6, f.cut_every_us)?;
         f.cut_for_us = dur("fault-cut-for", cli.fault_cut_for, 1e6, f.cut_for_us)?;

@@ -7,10 +7,12 @@
 //! several physics sub-steps. Everything random is drawn from the seed, so a run is a function
 //! of the seed, the options and the bytes received at each tick.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use pushbot_firmware::{Core, Inputs, RobotParams};
+use pushbot_protocol::{Command, Faults, FrameDecoder, HostFrame};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -114,6 +116,11 @@ pub struct Sim {
     substeps: u32,
     duty: [f32; 2],
     tx: [u8; 512],
+    /// The simulator's own view of the host's frames: which `Hello` opened the session.
+    shadow: FrameDecoder,
+    session_hello: Option<u16>,
+    starts: BTreeMap<u16, u32>,
+    watchdog_trips: u64,
 }
 
 impl Sim {
@@ -153,6 +160,10 @@ impl Sim {
             substeps: opts.substeps,
             duty: [0.0; 2],
             tx: [0; 512],
+            shadow: FrameDecoder::new(),
+            session_hello: None,
+            starts: BTreeMap::new(),
+            watchdog_trips: 0,
         })
     }
 
@@ -166,11 +177,45 @@ impl Sim {
         self.tick_us
     }
 
-    /// Hand bytes from the host to the firmware, at the current simulated time.
+    /// Hand bytes from the host to the firmware, at the current simulated time. Every motion
+    /// primitive the core starts is counted by its sequence number ([`Sim::starts`]).
     pub fn receive(&mut self, bytes: &[u8]) {
-        if !bytes.is_empty() {
-            self.core.receive(self.now_us, bytes);
+        for &b in bytes {
+            let hello = match self.shadow.push::<HostFrame>(b) {
+                Some(Ok(HostFrame {
+                    seq,
+                    cmd: Command::Hello { .. },
+                })) => Some(seq),
+                _ => None,
+            };
+            let before = self.core.active();
+            self.core.receive(self.now_us, &[b]);
+            if let Some(seq) = hello
+                && self.core.has_session()
+                && self.session_hello != Some(seq)
+            {
+                // A new session (not a retried `Hello`): its numbers start afresh.
+                self.session_hello = Some(seq);
+                self.starts.clear();
+            }
+            let after = self.core.active();
+            if let Some(seq) = after
+                && after != before
+            {
+                *self.starts.entry(seq).or_insert(0) += 1;
+            }
         }
+    }
+
+    /// How many times the core started a motion primitive, by sequence number, in the current
+    /// session (the simulator's own count: a primitive executed twice counts 2).
+    pub fn starts(&self) -> &BTreeMap<u16, u32> {
+        &self.starts
+    }
+
+    /// How many times the link watchdog latched `LINK_LOST` since boot.
+    pub fn watchdog_trips(&self) -> u64 {
+        self.watchdog_trips
     }
 
     /// One firmware control period: read the sensors, step the core, move the world.
@@ -185,7 +230,11 @@ impl Sim {
                 .switches
                 .read(self.now_us, self.world.pressed(), &mut self.rng),
         };
+        let lost = self.core.faults().contains(Faults::LINK_LOST);
         let out = self.core.step(self.now_us, &inputs);
+        if !lost && self.core.faults().contains(Faults::LINK_LOST) {
+            self.watchdog_trips += 1;
+        }
         self.duty = out.duty;
         let dt = f64::from(self.tick_us) * 1e-6 / f64::from(self.substeps);
         for _ in 0..self.substeps {

@@ -17,6 +17,9 @@ use pushbot_tests::{SIM_SPEED, angle_diff, dist, wait_truth};
 const FAULTS: LinkFaults = LinkFaults {
     drop: 0.005,
     corrupt: 0.005,
+    garbage: 0.0,
+    frame_loss: 0.0,
+    duplicate: 0.0,
     max_delay_us: 5_000,
     cut_every_us: 2_000_000,
     cut_for_us: 150_000,
