@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub mod demo;
+pub mod link_bench;
 pub mod rearrange;
 pub mod robot;
 pub mod scene;
@@ -90,6 +91,9 @@ pub enum BenchCommand {
     Rearrange(rearrange::BenchArgs),
     /// Plan time of the stable-pushing presets next to the paper's.
     Stable(stable::BenchStableArgs),
+    /// Commands through a faulty wire to the built-in simulated target: what completed, what
+    /// the robot executed twice, watchdog trips, retries, latency.
+    Link(link_bench::BenchLinkArgs),
     #[command(flatten)]
     Vision(vision::BenchCommand),
     #[command(flatten)]
@@ -195,6 +199,10 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ("bench", "pushbot bench stable --repeat 3"),
     ("bench rearrange", "pushbot bench rearrange --quick"),
     ("bench stable", "pushbot bench stable --repeat 3 --json"),
+    (
+        "bench link",
+        "pushbot bench link --commands 10000 --corrupt 0.01 --frame-loss 0.05 --duplicate 0.01",
+    ),
     ("bench vision", "pushbot bench vision --frames 50"),
     (
         "bench knn",
@@ -318,6 +326,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Plan(PlanCommand::Stable(a)) => stable::run_plan(&global, &a),
         Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
         Command::Bench(BenchCommand::Stable(a)) => stable::run_bench(&global, &a),
+        Command::Bench(BenchCommand::Link(a)) => link_bench::run(&global, &a),
         Command::Calibrate(a) => vision::calibrate(&global, a),
         Command::Track(a) => vision::track(&global, a),
         Command::Bench(BenchCommand::Vision(b)) => vision::bench(&global, b),

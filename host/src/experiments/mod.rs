@@ -7,11 +7,15 @@
 //!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
+//! - `link_bench`: commands through a faulty wire to the in-process target (`pushbot bench
+//!   link`).
 
 #[cfg(feature = "sim")]
 pub mod delivery;
 #[cfg(feature = "sim")]
 pub mod demo;
+#[cfg(feature = "sim")]
+pub mod link_bench;
 #[cfg(feature = "sim")]
 pub mod strategy_eval;
 pub mod trials;

@@ -3,12 +3,16 @@
 //! host time is the simulated time, so everything runs as fast as the machine goes and is a
 //! function of the seed. It only moves bytes and time: before each tick the client's
 //! transmits go into the simulator, after it the simulator's output goes to the client.
+//!
+//! With [`InProcess::with_faults`] a seeded fault pipe ([`FaultyLink`]: drops, bit flips,
+//! garbage, lost and duplicated frames, delays, cuts) sits between the two, one per direction.
 
 use std::ops::Deref;
 use std::sync::mpsc;
 use std::sync::{Mutex, MutexGuard};
 
 use pushbot_sim::Sim;
+use pushbot_sim::faults::{FaultyLink, LinkFaults};
 
 use crate::link::driver::{Subscribers, silent};
 use crate::link::{Client, ClientOptions, Driver, HostTime, LinkError, RobotEvent};
@@ -19,6 +23,7 @@ pub struct Inner {
     client: Client,
     subscribers: Subscribers,
     rx: Vec<u8>,
+    faults: Option<FaultyLink>,
 }
 
 /// The link client on a simulator in process.
@@ -48,7 +53,10 @@ impl Inner {
     fn flush(&mut self) {
         let now = self.now();
         while let Some(bytes) = self.client.poll_transmit(now) {
-            self.sim.receive(&bytes);
+            match self.faults.as_mut() {
+                Some(link) => link.from_host(now.as_micros(), &bytes),
+                None => self.sim.receive(&bytes),
+            }
         }
         self.subscribers.dispatch(&mut self.client);
     }
@@ -56,10 +64,22 @@ impl Inner {
     /// One tick of the simulator, with the bytes either way.
     fn step(&mut self) {
         self.flush();
+        if let Some(link) = self.faults.as_mut() {
+            self.rx.clear();
+            link.to_robot(self.sim.now_us(), &mut self.rx);
+            self.sim.receive(&self.rx);
+        }
         self.sim.tick();
         let now = self.now();
         self.rx.clear();
         self.sim.transmit(&mut self.rx);
+        if let Some(link) = self.faults.as_mut() {
+            let sent = std::mem::take(&mut self.rx);
+            link.from_robot(now.as_micros(), &sent);
+            self.rx = sent;
+            self.rx.clear();
+            link.to_host(now.as_micros(), &mut self.rx);
+        }
         let rx = std::mem::take(&mut self.rx);
         self.client.handle_bytes(now, &rx);
         self.rx = rx;
@@ -96,8 +116,37 @@ impl InProcess {
                 client,
                 subscribers: Subscribers::default(),
                 rx: Vec::new(),
+                faults: None,
             }),
         }
+    }
+
+    /// Drive `sim` as [`InProcess::new`] does, through a fault pipe with `faults` in each
+    /// direction, drawing from `seed`.
+    pub fn with_faults(sim: Sim, opts: ClientOptions, faults: LinkFaults, seed: u64) -> InProcess {
+        let driver = InProcess::new(sim, opts);
+        driver.lock().faults = Some(FaultyLink::new(faults, seed));
+        driver
+    }
+
+    /// Cut the wire both ways from now for `len_us` of simulated time (no effect without a
+    /// fault pipe).
+    pub fn cut_for(&self, len_us: u64) {
+        let mut inner = self.lock();
+        let now = inner.sim.now_us();
+        if let Some(link) = inner.faults.as_mut() {
+            link.cut_for(now, len_us);
+        }
+    }
+
+    /// What the fault pipe did so far (host → robot, robot → host), if there is one.
+    pub fn fault_stats(
+        &self,
+    ) -> Option<(
+        pushbot_sim::faults::PipeStats,
+        pushbot_sim::faults::PipeStats,
+    )> {
+        self.lock().faults.as_ref().map(FaultyLink::stats)
     }
 
     fn lock(&self) -> MutexGuard<'_, Inner> {

@@ -30,6 +30,12 @@
 //! robot's link watchdog counts robot time, so a heartbeat goes out whenever the telemetry shows
 //! that a quarter of the watchdog period of *robot* time has passed since the last frame sent;
 //! a quarter period of host time also triggers one, for a robot whose telemetry is off.
+//!
+//! A noisy wire (a frame from the robot rejected, or a gap in its telemetry, within the last
+//! [`NOISY_FOR`] of host time) tightens the policy: heartbeats go every eighth of the watchdog
+//! period (eight chances before the watchdog trips instead of four), a command is sent up to
+//! twice `attempts` times, and a motion whose `Ack` was lost counts as accepted as soon as the
+//! telemetry shows it running or ended under its number. A clean wire keeps the plain policy.
 
 use std::collections::{HashMap, VecDeque};
 use std::time::Duration;
@@ -52,6 +58,8 @@ const MAX_KEPT: usize = 64;
 const RECENT_DONES: usize = 16;
 /// How many rounds of `Hello` a sequence collision may cost.
 const HELLO_ROUNDS: u32 = 3;
+/// How long a rejected frame or a telemetry gap marks the wire as noisy, host time.
+pub const NOISY_FOR: Duration = Duration::from_secs(5);
 
 /// A command sent and not yet answered.
 #[derive(Debug, Clone, Copy)]
@@ -102,6 +110,10 @@ pub struct Client {
     watchdog_ms: u16,
     heartbeats_paused: bool,
     dead_reported: bool,
+    /// The wire counts as noisy until then (see the module docs).
+    noisy_until: Option<HostTime>,
+    /// The shortest step between telemetries seen, µs of robot time (the robot's period).
+    telemetry_step_us: Option<u64>,
 }
 
 /// Whether a heartbeat is due: a quarter watchdog period of robot time since the last frame
@@ -147,6 +159,8 @@ impl Client {
             watchdog_ms: opts.watchdog_ms,
             heartbeats_paused: false,
             dead_reported: false,
+            noisy_until: None,
+            telemetry_step_us: None,
             opts,
         }
     }
@@ -268,8 +282,9 @@ impl Client {
     pub fn poll_timeout(&self) -> Option<HostTime> {
         let retries = self.pending.iter().map(|p| p.deadline);
         let heartbeat = (!self.heartbeats_paused).then(|| {
-            self.last_tx
-                .after(Duration::from_micros(u64::from(self.watchdog_ms) * 250))
+            self.last_tx.after(Duration::from_micros(
+                u64::from(self.paced_watchdog_ms(self.last_tx)) * 250,
+            ))
         });
         let dead = (!self.dead_reported).then(|| {
             self.last_rx
@@ -299,6 +314,7 @@ impl Client {
                 }) => {
                     tracing::debug!("rejected frame from the robot: {error}");
                     self.stats.frames_rejected += 1;
+                    self.mark_noisy(now);
                     if let (Some(robot), Some(_)) = (foreign_hello, self.hello) {
                         self.finish_hello(Handshake::VersionMismatch {
                             host: self.opts.protocol_version,
@@ -321,7 +337,7 @@ impl Client {
                 i += 1;
                 continue;
             }
-            if p.sent < p.max {
+            if p.sent < p.max || (self.noisy(now) && p.sent < 2 * p.max) {
                 tracing::debug!("no answer to {:?} #{}; resending", p.frame.cmd, p.frame.seq);
                 self.stats.retries += 1;
                 self.send_frame(now, &p.frame);
@@ -352,13 +368,31 @@ impl Client {
         }
     }
 
+    /// Whether the wire counts as noisy at `now`.
+    pub fn noisy(&self, now: HostTime) -> bool {
+        self.noisy_until.is_some_and(|t| now < t)
+    }
+
+    fn mark_noisy(&mut self, now: HostTime) {
+        self.noisy_until = Some(now.after(NOISY_FOR));
+    }
+
+    /// The watchdog period heartbeats are paced for at `now`: half the real one on a noisy wire.
+    fn paced_watchdog_ms(&self, now: HostTime) -> u16 {
+        if self.noisy(now) {
+            (self.watchdog_ms / 2).max(1)
+        } else {
+            self.watchdog_ms
+        }
+    }
+
     fn heartbeat_if_due(&mut self, now: HostTime) {
         if self.heartbeats_paused
             || !heartbeat_due(
                 self.telemetry.map(|t| t.time_us),
                 self.last_tx_robot_us,
                 now.since(self.last_tx),
-                self.watchdog_ms,
+                self.paced_watchdog_ms(now),
             )
         {
             return;
@@ -460,14 +494,66 @@ impl Client {
             },
             RobotMsg::Done(d) => self.done(d, false),
             RobotMsg::Telemetry(t) => {
+                self.telemetry_gap(now, &t);
                 self.telemetry = Some(t);
                 self.events.push_back(Event::Telemetry(t));
+                self.ack_from_telemetry(now, &t);
                 self.watch_telemetry(&t);
             }
             RobotMsg::Contact(c) => {
                 self.contacts.push(c);
                 self.events.push_back(Event::Contact(c));
             }
+        }
+    }
+
+    /// Learn the robot's telemetry period; a step of more than one and a half periods means a
+    /// telemetry frame was lost: the wire is noisy.
+    fn telemetry_gap(&mut self, now: HostTime, t: &Telemetry) {
+        let Some(last) = self.telemetry.map(|l| l.time_us) else {
+            return;
+        };
+        if t.time_us <= last {
+            return;
+        }
+        let step = t.time_us - last;
+        let period = *self.telemetry_step_us.get_or_insert(step);
+        if step < period {
+            self.telemetry_step_us = Some(step);
+        } else if 2 * step > 3 * period {
+            self.mark_noisy(now);
+        }
+    }
+
+    /// On a noisy wire, a motion whose `Ack` was lost is accepted when the telemetry shows it
+    /// running or ended under its number.
+    fn ack_from_telemetry(&mut self, now: HostTime, t: &Telemetry) {
+        if !self.noisy(now) {
+            return;
+        }
+        let seen: Vec<u16> = self
+            .watched
+            .iter()
+            .filter(|w| !w.acked)
+            .map(|w| w.seq)
+            .filter(|&seq| t.active == Some(seq) || t.last_done.is_some_and(|(d, _)| d == seq))
+            .collect();
+        for seq in seen {
+            if !self.take_pending(seq) {
+                continue;
+            }
+            tracing::debug!("#{seq}: acknowledgement read from the telemetry");
+            if let Some(w) = self.watched.iter_mut().find(|w| w.seq == seq) {
+                w.acked = true;
+                w.started_us = Some(t.time_us);
+            }
+            self.answer(
+                seq,
+                Answer::Ack {
+                    at_us: Some(t.time_us),
+                },
+            );
+            self.events.push_back(Event::Ack { seq });
         }
     }
 

@@ -1,0 +1,93 @@
+//! `pushbot bench link`: arguments and printing of the link bench
+//! (`crate::experiments::link_bench`, which needs the built-in simulated target).
+
+use clap::Args;
+
+use super::{CliError, CliResult, Global, Status};
+
+/// `pushbot bench link`.
+#[derive(Args, Debug, Clone)]
+pub struct BenchLinkArgs {
+    /// Commands to send (a mix of moves, spins, stops and queries).
+    #[arg(long, default_value_t = 1000)]
+    pub commands: usize,
+    /// Probability that a byte has a bit flipped, each direction.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    pub corrupt: f64,
+    /// Probability that a whole frame is lost, each direction.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    pub frame_loss: f64,
+    /// Probability that a frame arrives twice, each direction.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    pub duplicate: f64,
+    /// Probability that a byte is lost, each direction.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    pub drop: f64,
+    /// Probability that a garbage byte is inserted before a byte, each direction.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    pub garbage: f64,
+}
+
+fn probability(name: &str, p: f64) -> Result<f64, CliError> {
+    if (0.0..=1.0).contains(&p) {
+        Ok(p)
+    } else {
+        Err(CliError::bad_input(format!(
+            "--{name} must be a probability in 0..=1, not {p}"
+        )))
+    }
+}
+
+/// Run `pushbot bench link`.
+#[cfg(feature = "sim")]
+pub fn run(g: &Global, a: &BenchLinkArgs) -> CliResult {
+    use crate::experiments::link_bench::{LinkBenchOptions, run};
+    let opts = LinkBenchOptions {
+        commands: a.commands,
+        corrupt: probability("corrupt", a.corrupt)?,
+        frame_loss: probability("frame-loss", a.frame_loss)?,
+        duplicate: probability("duplicate", a.duplicate)?,
+        drop: probability("drop", a.drop)?,
+        garbage: probability("garbage", a.garbage)?,
+        seed: g.seed,
+        ..LinkBenchOptions::default()
+    };
+    let r = run(&opts)?;
+    if g.json {
+        let line = serde_json::to_string(&r).map_err(|e| CliError::Failed(e.into()))?;
+        println!("{line}");
+        return Ok(Status::Success);
+    }
+    let share = |n: usize| 100.0 * n as f64 / r.sent.max(1) as f64;
+    println!("| link bench (seed {}) | value |", g.seed);
+    println!("|---|---|");
+    println!("| sent | {} |", r.sent);
+    println!(
+        "| completed | {} ({:.2} %) |",
+        r.completed,
+        share(r.completed)
+    );
+    println!("| refused | {} |", r.refused);
+    println!("| failed (motion ended otherwise) | {} |", r.failed);
+    println!("| unknown | {} |", r.unknown);
+    println!("| motions the robot started | {} |", r.motions_started);
+    println!("| executed twice | {} |", r.executed_twice);
+    println!("| motions nobody asked for | {} |", r.unasked_motions);
+    println!("| watchdog trips | {} |", r.watchdog_trips);
+    println!("| recoveries | {} |", r.recoveries);
+    println!("| retries per command | {:.3} |", r.retries_per_command);
+    println!(
+        "| latency p50 / p99 (robot time) | {:.1} / {:.1} ms |",
+        r.latency_ms.p50, r.latency_ms.p99
+    );
+    println!("| robot time | {:.1} s |", r.robot_time_s);
+    println!("| wall time | {:.1} s |", r.wall_s);
+    Ok(Status::Success)
+}
+
+/// Run `pushbot bench link` (this build has no simulated target).
+#[cfg(not(feature = "sim"))]
+pub fn run(_g: &Global, a: &BenchLinkArgs) -> CliResult {
+    probability("corrupt", a.corrupt)?;
+    Err(super::no_simulated_target())
+}
