@@ -601,3 +601,56 @@ fn configure_goes_through_the_firmware() {
     c.handle_bytes(ms(11), &reply);
     assert!(matches!(c.take_answer(seq), Some(Answer::Ack { .. })));
 }
+
+#[test]
+fn a_noisy_wire_tightens_the_policy() {
+    let mut c = Client::new(ms(0), opts());
+    // A steady telemetry on a clean wire: the plain policy.
+    c.handle_bytes(ms(1), &wire(&[telemetry(1_000_000, None, None)]));
+    c.handle_bytes(ms(2), &wire(&[telemetry(1_020_000, None, None)]));
+    assert!(!c.noisy(ms(2)));
+    // A frame with a bad CRC: noisy for five seconds.
+    c.handle_bytes(ms(3), &[1, 2, 3, 4, 5, 6, 0]);
+    assert_eq!(c.stats().frames_rejected, 1);
+    assert!(c.noisy(ms(3)) && c.noisy(ms(5002)) && !c.noisy(ms(5003)));
+    sent(&mut c, ms(3));
+    // Heartbeats every eighth of the 200 ms watchdog (host-time fallback: 25 ms).
+    c.handle_timeout(ms(28));
+    assert_eq!(sent(&mut c, ms(28)).1.len(), 1);
+    assert_eq!(c.poll_timeout(), Some(ms(53)));
+
+    // A motion whose Ack is lost is accepted when the telemetry shows it running.
+    let mv = Command::Move {
+        distance: 0.1,
+        speed: 0.2,
+        stop_on_contact: false,
+    };
+    let seq = c.motion(ms(30), mv, 10_000_000);
+    sent(&mut c, ms(30));
+    c.handle_bytes(ms(31), &wire(&[telemetry(1_040_000, Some(seq), None)]));
+    assert_eq!(
+        c.take_answer(seq),
+        Some(Answer::Ack {
+            at_us: Some(1_040_000)
+        })
+    );
+    c.handle_timeout(ms(200));
+    assert!(
+        !sent(&mut c, ms(200)).1.iter().any(|f| f.cmd == mv),
+        "not resent once seen running"
+    );
+
+    // Twice the attempts while the wire stays noisy.
+    let stop = c.command(ms(300), Command::Stop);
+    let is_stop = |f: &&HostFrame| f.seq == stop && f.cmd == Command::Stop;
+    let mut sends = sent(&mut c, ms(300)).1.iter().filter(is_stop).count();
+    let mut now = 300;
+    while c.take_answer(stop).is_none() {
+        now += 150;
+        c.handle_bytes(ms(now), &[9, 9, 9, 0]); // more noise
+        c.handle_timeout(ms(now));
+        sends += sent(&mut c, ms(now)).1.iter().filter(is_stop).count();
+        assert!(now < 5000);
+    }
+    assert_eq!(sends, 10);
+}
