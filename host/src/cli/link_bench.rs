@@ -3,7 +3,7 @@
 
 use clap::Args;
 
-use super::{CliError, CliResult, Global, Status};
+use super::{CliError, CliResult, Global};
 
 /// `pushbot bench link`.
 #[derive(Args, Debug, Clone)]
@@ -41,6 +41,7 @@ fn probability(name: &str, p: f64) -> Result<f64, CliError> {
 /// Run `pushbot bench link`.
 #[cfg(feature = "sim")]
 pub fn run(g: &Global, a: &BenchLinkArgs) -> CliResult {
+    use super::Status;
     use crate::experiments::link_bench::{LinkBenchOptions, run};
     let opts = LinkBenchOptions {
         commands: a.commands,
