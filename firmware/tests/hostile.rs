@@ -14,8 +14,8 @@
 
 use pushbot_firmware::{Core, Inputs, Mode, RobotParams};
 use pushbot_protocol::{
-    Command, ConfigUpdate, FrameDecoder, HostFrame, MAX_FRAME, PROTOCOL_VERSION,
-    Pose, RobotMsg, WheelGains, decode_payload, encode_frame,
+    Command, ConfigUpdate, FrameDecoder, HostFrame, MAX_FRAME, PROTOCOL_VERSION, Pose, RobotMsg,
+    WheelGains, decode_payload, encode_frame,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

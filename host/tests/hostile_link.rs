@@ -110,7 +110,9 @@ fn robot_msg(rng: &mut impl Rng, next_seq: u16, robot_us: u64) -> RobotMsg {
         4 => RobotMsg::Nack {
             seq: s1,
             reason: match rng.random_range(0..4) {
-                0 => NackReason::VersionMismatch { robot: rng.random() },
+                0 => NackReason::VersionMismatch {
+                    robot: rng.random(),
+                },
                 1 => NackReason::NoSession,
                 2 => NackReason::OutOfRange,
                 _ => NackReason::Faulted(Faults(rng.random())),
@@ -177,9 +179,6 @@ impl Model {
             self.pending.insert(self.next_seq, Issued::Hello);
             self.next_seq = self.next_seq.wrapping_add(1);
         }
-        if c.handshake().is_some() {
-            self.hello_open = false;
-        }
     }
 
     fn issue(&mut self, c: &Client, seq: u16, what: Issued) {
@@ -236,7 +235,10 @@ impl Model {
                     }
                     self.recent_dones.push_back(done.seq);
                     let watched = self.watched.remove(&done.seq);
-                    assert!(watched || !recovered, "recovered {e:?} for no watched motion");
+                    assert!(
+                        watched || !recovered,
+                        "recovered {e:?} for no watched motion"
+                    );
                     if watched {
                         let same = |m: &MotionEnd| {
                             matches!(m, MotionEnd::Done { done: d, recovered: r, .. }
@@ -253,6 +255,10 @@ impl Model {
                 Event::Contact(_) => self.contact_events += 1,
                 Event::LinkDead { .. } => {}
             }
+        }
+        // A handshake that ended without an event (too many sequence collisions) ended too.
+        if c.handshake().is_some() {
+            self.hello_open = false;
         }
     }
 }
@@ -320,7 +326,9 @@ fn run(seed: u64, frames: u64) -> (Model, [u64; MUTATIONS.len()]) {
     let mut generated = 0u64;
     let mut stream = Vec::new();
     while generated < frames {
-        now = now.after(std::time::Duration::from_micros(rng.random_range(0..30_000)));
+        now = now.after(std::time::Duration::from_micros(
+            rng.random_range(0..30_000),
+        ));
         robot_us = if rng.random_bool(0.001) {
             rng.random_range(0..1_000_000) // the robot restarted
         } else {
@@ -407,4 +415,47 @@ fn hostile_frames_into_the_client() {
     // The run exercised what it claims.
     assert!(by_kind.iter().all(|&k| k > 1000), "{by_kind:?}");
     assert!(model.motion_ends > 1000);
+}
+
+/// Found by the run above: a `Done` under a number the client later gives a motion, then a
+/// telemetry naming that motion as ended, made `watch_telemetry` loop forever (the repeated
+/// `Done` was ignored and the motion never left the watch list). Now the motion stays watched
+/// and ends by its budget.
+#[test]
+fn a_stale_done_under_a_motions_number_does_not_hang_the_client() {
+    let now = HostTime::from_micros(0);
+    let mut c = Client::new(now, ClientOptions::default());
+    let seq = c.next_seq();
+    let stale = Done {
+        seq,
+        outcome: Outcome::Completed,
+        pose: Pose::default(),
+        time_us: 1,
+    };
+    c.handle_bytes(now, &encoded(&RobotMsg::Done(stale)));
+    let motion = Command::Spin {
+        angle: 1.0,
+        rate: 1.0,
+    };
+    assert_eq!(c.motion(now, motion, 1_000), seq);
+    c.handle_bytes(now, &encoded(&RobotMsg::Ack { seq }));
+    let telemetry = |time_us| {
+        RobotMsg::Telemetry(Telemetry {
+            time_us,
+            pose: Pose::default(),
+            wheel_speed: [0.0; 2],
+            bumper: 0,
+            mode: Mode::Idle,
+            faults: Faults::NONE,
+            active: None,
+            last_done: Some((seq, Outcome::Completed)),
+        })
+    };
+    c.handle_bytes(now, &encoded(&telemetry(10))); // looped forever before the fix
+    assert_eq!(c.take_motion_end(seq), None);
+    c.handle_bytes(now, &encoded(&telemetry(10_000)));
+    assert_eq!(
+        c.take_motion_end(seq),
+        Some(MotionEnd::TimedOut { budget_us: 1_000 })
+    );
 }
