@@ -10,7 +10,7 @@
 //! * the core answers with frames that decode.
 //!
 //! Frame count: `CASES` × 1..=6 frames, 520 000 generated frames in all (with
-//! `host/tests/hostile_link.rs`, over 10⁶). About 2 s at the test profile (opt-level 1).
+//! `host/tests/hostile_link.rs`, over 10⁶). About 1 s at the test profile (opt-level 1).
 
 use pushbot_firmware::{Core, Inputs, Mode, RobotParams};
 use pushbot_protocol::{

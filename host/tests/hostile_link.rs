@@ -13,8 +13,8 @@
 //! * the counters of frames decoded and rejected, the bytes received, the telemetry and the
 //!   contacts agree with a reference `FrameDecoder` fed the same bytes.
 //!
-//! Frame count: 520 000 generated frames (with `firmware/tests/hostile.rs`, over 10⁶), a few
-//! seconds at the test profile (opt-level 1).
+//! Frame count: 520 000 generated frames (with `firmware/tests/hostile.rs`, over 10⁶),
+//! about 1 s at the test profile (opt-level 1).
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
