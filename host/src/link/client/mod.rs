@@ -614,10 +614,14 @@ impl Client {
                     time_us: t.time_us,
                 };
                 self.done(done, true);
-                continue; // `done` removed it
+                if self.watched.get(i).is_none_or(|w| w.seq != seq) {
+                    continue; // `done` removed it
+                }
+                // A `Done` under this number was seen already (a stale one, from before the
+                // motion was sent): `done` ignored it; the motion stays watched, on its budget.
             }
-            if t.time_us.saturating_sub(start) > w.budget_us {
-                let budget_us = w.budget_us;
+            let budget_us = self.watched[i].budget_us;
+            if t.time_us.saturating_sub(start) > budget_us {
                 self.watched.remove(i);
                 self.end_motion(seq, MotionEnd::TimedOut { budget_us });
                 self.events
