@@ -3,54 +3,7 @@
 //! frames, delayed bursts (order kept), and link cuts during which every byte is lost. Times
 //! are simulated time. Each direction is a sans-IO [`FaultPipe`] (`crate::fault_pipe`).
 
-pub use crate::fault_pipe::{FaultPipe, PipeStats};
-
-/// What goes wrong on the link, and how often.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LinkFaults {
-    /// Probability that a byte is lost.
-    pub drop: f64,
-    /// Probability that a byte has one bit flipped.
-    pub corrupt: f64,
-    /// Probability that a random byte is inserted before a byte.
-    pub garbage: f64,
-    /// Probability that a whole frame (up to its `0x00` delimiter) is lost.
-    pub frame_loss: f64,
-    /// Probability that a frame is delivered twice.
-    pub duplicate: f64,
-    /// Each burst of bytes is held for a delay drawn uniformly from 0..=`max_delay_us`.
-    pub max_delay_us: u64,
-    /// The link is cut for `cut_for_us` at the end of every `cut_every_us` (0 = never).
-    pub cut_every_us: u64,
-    /// Length of each cut.
-    pub cut_for_us: u64,
-}
-
-impl Default for LinkFaults {
-    /// The `--faults` profile: 0.1 % drops, 0.1 % corruptions, up to 20 ms delay, and a
-    /// 300 ms cut every 10 s.
-    fn default() -> Self {
-        LinkFaults {
-            drop: 1e-3,
-            corrupt: 1e-3,
-            garbage: 0.0,
-            frame_loss: 0.0,
-            duplicate: 0.0,
-            max_delay_us: 20_000,
-            cut_every_us: 10_000_000,
-            cut_for_us: 300_000,
-        }
-    }
-}
-
-impl LinkFaults {
-    /// Whether the link is cut at `now_us`.
-    pub fn cut(&self, now_us: u64) -> bool {
-        self.cut_every_us > 0
-            && self.cut_for_us > 0
-            && now_us % self.cut_every_us >= self.cut_every_us.saturating_sub(self.cut_for_us)
-    }
-}
+pub use crate::fault_pipe::{FaultPipe, LinkFaults, PipeStats};
 
 /// Both directions of a faulty link: one [`FaultPipe`] each, on their own streams of the seed.
 #[derive(Clone, Debug)]
