@@ -8,8 +8,12 @@ use pushbot_protocol::{
 };
 
 mod common;
+/// The framing written apart from the protocol crate (CRC-32C, COBS), shared with the hostile
+/// tests.
+mod hostile_gen;
 
 use common::{Bench, Lcg};
+use hostile_gen::{cobs_encode, crc32c};
 
 #[test]
 fn watchdog_cuts_duty_within_one_tick() {
@@ -171,47 +175,6 @@ fn garbage_bytes_never_cause_motion() {
     }
     assert!(!b.any_motion());
     assert!(b.core.rx_rejected() > 0);
-}
-
-fn crc32c(bytes: &[u8]) -> u32 {
-    // Bitwise CRC-32C (Castagnoli, reflected 0x82F63B78), independent of the protocol crate.
-    let mut crc = !0u32;
-    for &b in bytes {
-        crc ^= b as u32;
-        for _ in 0..8 {
-            crc = if crc & 1 != 0 {
-                (crc >> 1) ^ 0x82F6_3B78
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
-}
-
-fn cobs_encode(raw: &[u8]) -> Vec<u8> {
-    let mut out = vec![0u8];
-    let mut code_at = 0;
-    let mut code = 1u8;
-    for &b in raw {
-        if b == 0 {
-            out[code_at] = code;
-            code_at = out.len();
-            out.push(0);
-            code = 1;
-        } else {
-            out.push(b);
-            code += 1;
-            if code == 0xFF {
-                out[code_at] = code;
-                code_at = out.len();
-                out.push(0);
-                code = 1;
-            }
-        }
-    }
-    out[code_at] = code;
-    out
 }
 
 #[test]
