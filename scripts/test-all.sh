@@ -6,7 +6,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # Each stage's heading carries the minutes since the start, so a slow stage shows in CI's log.
-say() { printf '\n== %s (at %dm%02ds)\n' "$*" $((SECONDS / 60)) $((SECONDS % 60)); }
+# It also says how much disk the build has taken so far: CI machines have little to spare.
+say() {
+  printf '\n== %s (at %dm%02ds; target/ %s)\n' "$*" $((SECONDS / 60)) $((SECONDS % 60)) \
+    "$(du -sh target 2>/dev/null | cut -f1 || echo 0)"
+}
+
+# The suite builds everything once, so incremental caches would only take disk (GBs) and time.
+export CARGO_INCREMENTAL=0
 
 say "installing what the tests need"
 need_pkgs=()
