@@ -5,6 +5,70 @@
 
 pub use crate::fault_pipe::{FaultPipe, LinkFaults, PipeStats};
 
+/// The link-fault flags, as `pushbot-sim` and `pushbot demo` take them (`--faults` and its
+/// `--fault-*` refinements): flatten into a clap parser, then [`FaultArgs::link_faults`].
+#[derive(clap::Args, Debug, Clone, Default, PartialEq)]
+pub struct FaultArgs {
+    /// Inject link faults (seeded): the default profile is 0.1 % dropped and 0.1 % corrupted
+    /// bytes, bursts delayed up to 20 ms, and a 300 ms cut every 10 s of simulated time.
+    #[arg(long)]
+    pub faults: bool,
+    /// With --faults: probability that a byte is dropped.
+    #[arg(long, value_name = "P", requires = "faults")]
+    pub fault_drop: Option<f64>,
+    /// With --faults: probability that a byte has a bit flipped.
+    #[arg(long, value_name = "P", requires = "faults")]
+    pub fault_corrupt: Option<f64>,
+    /// With --faults: probability that a random byte is inserted before a byte (garbage).
+    #[arg(long, value_name = "P", requires = "faults")]
+    pub fault_garbage: Option<f64>,
+    /// With --faults: probability that a whole frame (up to its 0x00 delimiter) is lost.
+    #[arg(long, value_name = "P", requires = "faults")]
+    pub fault_frame_loss: Option<f64>,
+    /// With --faults: probability that a frame is delivered twice.
+    #[arg(long, value_name = "P", requires = "faults")]
+    pub fault_duplicate: Option<f64>,
+    /// With --faults: longest delay of a burst of bytes, ms.
+    #[arg(long, value_name = "MS", requires = "faults")]
+    pub fault_delay_ms: Option<f64>,
+    /// With --faults: cut the link every this many seconds of simulated time (0 = never)…
+    #[arg(long, value_name = "S", requires = "faults")]
+    pub fault_cut_every: Option<f64>,
+    /// …for this many seconds.
+    #[arg(long, value_name = "S", requires = "faults")]
+    pub fault_cut_for: Option<f64>,
+}
+
+impl FaultArgs {
+    /// The faults these flags ask for (`None` without `--faults`), or what is wrong with them.
+    pub fn link_faults(&self) -> Result<Option<LinkFaults>, String> {
+        if !self.faults {
+            return Ok(None);
+        }
+        let prob = |name: &str, p: Option<f64>, default: f64| match p {
+            None => Ok(default),
+            Some(p) if (0.0..=1.0).contains(&p) => Ok(p),
+            Some(p) => Err(format!("--{name} must be a probability in 0..=1, not {p}")),
+        };
+        let dur = |name: &str, s: Option<f64>, scale: f64, default: u64| match s {
+            None => Ok(default),
+            Some(s) if s.is_finite() && s >= 0.0 && s * scale < 1e15 => Ok((s * scale) as u64),
+            Some(s) => Err(format!("--{name} must be a duration ≥ 0, not {s}")),
+        };
+        let d = LinkFaults::default();
+        Ok(Some(LinkFaults {
+            drop: prob("fault-drop", self.fault_drop, d.drop)?,
+            corrupt: prob("fault-corrupt", self.fault_corrupt, d.corrupt)?,
+            garbage: prob("fault-garbage", self.fault_garbage, d.garbage)?,
+            frame_loss: prob("fault-frame-loss", self.fault_frame_loss, d.frame_loss)?,
+            duplicate: prob("fault-duplicate", self.fault_duplicate, d.duplicate)?,
+            max_delay_us: dur("fault-delay-ms", self.fault_delay_ms, 1e3, d.max_delay_us)?,
+            cut_every_us: dur("fault-cut-every", self.fault_cut_every, 1e6, d.cut_every_us)?,
+            cut_for_us: dur("fault-cut-for", self.fault_cut_for, 1e6, d.cut_for_us)?,
+        }))
+    }
+}
+
 /// Both directions of a faulty link: one [`FaultPipe`] each, on their own streams of the seed.
 #[derive(Clone, Debug)]
 pub struct FaultyLink {

@@ -14,7 +14,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use pushbot_sim::faults::LinkFaults;
+use pushbot_sim::faults::FaultArgs;
 use pushbot_sim::pushing::Slider;
 use pushbot_sim::{Pose, PtySim, Scene, SimOptions};
 
@@ -57,34 +57,20 @@ struct Cli {
     /// centre, facing +x).
     #[arg(long, num_args = 3, value_names = ["X", "Y", "HEADING_DEG"], allow_negative_numbers = true)]
     start: Option<Vec<f64>>,
-    /// Inject link faults (seeded): the default profile is 0.1 % dropped and 0.1 % corrupted
-    /// bytes, bursts delayed up to 20 ms, and a 300 ms cut every 10 s of simulated time.
-    #[arg(long)]
-    faults: bool,
-    /// With --faults: probability that a byte is dropped.
-    #[arg(long, value_name = "P", requires = "faults")]
-    fault_drop: Option<f64>,
-    /// With --faults: probability that a byte has a bit flipped.
-    #[arg(long, value_name = "P", requires = "faults")]
-    fault_corrupt: Option<f64>,
-    /// With --faults: probability that a random byte is inserted before a byte (garbage).
-    #[arg(long, value_name = "P", requires = "faults")]
-    fault_garbage: Option<f64>,
-    /// With --faults: probability that a whole frame (up to its 0x00 delimiter) is lost.
-    #[arg(long, value_name = "P", requires = "faults")]
-    fault_frame_loss: Option<f64>,
-    /// With --faults: probability that a frame is delivered twice.
-    #[arg(long, value_name = "P", requires = "faults")]
-    fault_duplicate: Option<f64>,
-    /// With --faults: longest delay of a burst of bytes, ms.
-    #[arg(long, value_name = "MS", requires = "faults")]
-    fault_delay_ms: Option<f64>,
-    /// With --faults: cut the link every this many seconds (0 = never)…
-    #[arg(long, value_name = "S", requires = "faults")]
-    fault_cut_every: Option<f64>,
-    /// …for this many seconds.
-    #[arg(long, value_name = "S", requires = "faults")]
-    fault_cut_for: Option<f64>,
+    /// Link faults.
+    #[command(flatten)]
+    faults: FaultArgs,
+    /// Keep a symlink at PATH to the robot's pty (as udev keeps `/dev/serial/by-id/…`): hosts
+    /// open PATH, which outlives unplugs. The first line's `serial` is then PATH.
+    #[arg(long, value_name = "PATH")]
+    link: Option<PathBuf>,
+    /// Unplug the port at this simulated time, s (repeatable): the pty closes under the host
+    /// and PATH vanishes, then a new pty is served behind PATH (a USB re-enumeration).
+    #[arg(long, value_name = "S", requires = "link")]
+    unplug_at: Vec<f64>,
+    /// How long each unplug lasts, s of simulated time.
+    #[arg(long, value_name = "S", default_value_t = 1.0, requires = "unplug_at")]
+    unplug_for: f64,
     /// Run until killed instead of until standard input closes.
     #[arg(long)]
     no_stdin: bool,
@@ -252,36 +238,29 @@ fn run(cli: Cli) -> Result<()> {
         Some(s) => (s.table.width, s.table.height, s.robot.start),
         None => (width, height, start),
     };
-    let faults = if cli.faults {
-        let mut f = LinkFaults::default();
-        let prob = |name: &str, p: Option<f64>, default: f64| -> Result<f64> {
-            match p {
-                None => Ok(default),
-                Some(p) if (0.0..=1.0).contains(&p) => Ok(p),
-                Some(p) => bad_input!("--{name} must be a probability in 0..=1, not {p}"),
-            }
-        };
-        let dur = |name: &str, s: Option<f64>, scale: f64, default: u64| -> Result<u64> {
-            match s {
-                None => Ok(default),
-                Some(s) if s.is_finite() && s >= 0.0 && s * scale < 1e15 => Ok((s * scale) as u64),
-                Some(s) => bad_input!("--{name} must be a duration ≥ 0, not {s}"),
-            }
-        };
-        f.drop = prob("fault-drop", cli.fault_drop, f.drop)?;
-        f.corrupt = prob("fault-corrupt", cli.fault_corrupt, f.corrupt)?;
-        f.garbage = prob("fault-garbage", cli.fault_garbage, f.garbage)?;
-        f.frame_loss = prob("fault-frame-loss", cli.fault_frame_loss, f.frame_loss)?;
-        f.duplicate = prob("fault-duplicate", cli.fault_duplicate, f.duplicate)?;
-        f.max_delay_us = dur("fault-delay-ms", cli.fault_delay_ms, 1e3, f.max_delay_us)?;
-        f.cut_every_us = dur("fault-cut-every", cli.fault_cut_every, 1e6, f.cut_every_us)?;
-        f.cut_for_us = dur("fault-cut-for", cli.fault_cut_for, 1e6, f.cut_for_us)?;
-        Some(f)
-    } else {
-        None
+    let faults = cli.faults.link_faults().map_err(BadInput)?;
+    let secs = |name: &str, s: f64| -> Result<u64> {
+        if s.is_finite() && (0.0..1e9).contains(&s) {
+            Ok((s * 1e6) as u64)
+        } else {
+            bad_input!("--{name} must be a time in seconds ≥ 0, not {s}")
+        }
     };
+    let unplug_for = secs("unplug-for", cli.unplug_for)?;
+    let unplugs = cli
+        .unplug_at
+        .iter()
+        .map(|&at| {
+            Ok(pushbot_sim::plug::Unplug {
+                at_us: secs("unplug-at", at)?,
+                for_us: unplug_for,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
     let opts = SimOptions {
         faults,
+        link: cli.link.clone(),
+        unplugs,
         scene: scene.clone(),
         seed: cli.seed,
         speed: cli.speed,

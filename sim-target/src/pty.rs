@@ -32,6 +32,7 @@ use rustix::pty::{OpenptFlags, grantpt, openpt, ptsname, unlockpt};
 use rustix::termios::{OptionalActions, QueueSelector, tcflush, tcgetattr, tcsetattr};
 
 use crate::faults::FaultyLink;
+use crate::plug::{PlugShared, Port};
 use crate::sim::{Sim, SimOptions, Truth, TruthRecord};
 
 /// A pseudo-terminal pair: the master the sim reads and writes, the slave a host opens.
@@ -133,6 +134,9 @@ const MAX_PENDING: usize = 64 * 1024;
 /// The simulated robot served on a pty from a background thread.
 pub struct PtySim {
     path: String,
+    /// Whether the port has a stable link path (and so can be unplugged).
+    linked: bool,
+    plug: Arc<PlugShared>,
     truth: Arc<Mutex<Truth>>,
     objects: Arc<Mutex<Vec<(String, crate::Pose)>>>,
     stop: Arc<AtomicBool>,
@@ -150,7 +154,8 @@ impl PtySim {
             anyhow::bail!("truth log rate must be positive, not {}", opts.truth_hz);
         }
         let sim = Sim::new(&opts)?;
-        let pty = Pty::open()?;
+        let plug = Arc::new(PlugShared::default());
+        let port = Port::open(opts.link.clone(), opts.unplugs.clone(), Arc::clone(&plug))?;
         let log = match &opts.truth_log {
             Some(p) => {
                 Some(BufWriter::new(File::create(p).with_context(|| {
@@ -159,7 +164,7 @@ impl PtySim {
             }
             None => None,
         };
-        let path = pty.path().to_owned();
+        let path = port.host_path();
         let truth = Arc::new(Mutex::new(sim.truth()));
         let objects = Arc::new(Mutex::new(sim.object_poses()));
         let stop = Arc::new(AtomicBool::new(false));
@@ -177,7 +182,7 @@ impl PtySim {
         };
         let runner = Runner {
             sim,
-            pty,
+            port,
             speed: opts.speed,
             log,
             log_period_us: ((1e6 / opts.truth_hz) as u64).max(1),
@@ -192,6 +197,8 @@ impl PtySim {
             .context("starting the simulation thread")?;
         Ok(PtySim {
             path,
+            linked: opts.link.is_some(),
+            plug,
             truth,
             objects,
             stop,
@@ -206,9 +213,32 @@ impl PtySim {
         self.camera.as_ref().map(|c| c.addr())
     }
 
-    /// Path of the robot's serial port: open it with `serialport` as a real robot's.
+    /// Path of the robot's serial port: open it with `serialport` as a real robot's. With a
+    /// link path ([`SimOptions::link`]) it is that path, which outlives unplugs.
     pub fn serial_path(&self) -> &str {
         &self.path
+    }
+
+    /// Unplug the port for `gap` of simulated time, then serve a new pty behind the same link
+    /// path (a USB re-enumeration). Needs [`SimOptions::link`].
+    pub fn unplug(&self, gap: Duration) -> Result<()> {
+        if !self.linked {
+            anyhow::bail!("unplugging the port needs a stable path for it (SimOptions::link)");
+        }
+        let us = u64::try_from(gap.as_micros()).unwrap_or(u64::MAX);
+        match self.plug.requests.lock() {
+            Ok(mut r) => r.push(us),
+            Err(p) => p.into_inner().push(us),
+        }
+        Ok(())
+    }
+
+    /// How many times the port was unplugged, and plugged back, so far.
+    pub fn unplugs(&self) -> (u32, u32) {
+        (
+            self.plug.unplugs.load(Ordering::Relaxed),
+            self.plug.replugs.load(Ordering::Relaxed),
+        )
     }
 
     /// The latest true object poses (scene order, with ids).
@@ -261,7 +291,7 @@ impl Drop for PtySim {
 /// The background loop's state.
 struct Runner {
     sim: Sim,
-    pty: Pty,
+    port: Port,
     speed: f64,
     log: Option<BufWriter<File>>,
     log_period_us: u64,
@@ -295,7 +325,7 @@ impl Runner {
         self.log_truth(&mut next_log_us)?;
         while !self.stop.load(Ordering::Relaxed) {
             loop {
-                let n = self.pty.read(&mut rx)?;
+                let n = self.port.read(&mut rx)?;
                 match self.link.as_mut() {
                     Some(link) => link.from_host(self.sim.now_us(), &rx[..n]),
                     None => self.sim.receive(&rx[..n]),
@@ -310,7 +340,7 @@ impl Runner {
                 let now = Instant::now();
                 if due > now + SLACK {
                     // Wake early if the host sends something, to hand it over in time.
-                    self.pty
+                    self.port
                         .wait_readable((due - now).min(Duration::from_millis(50)))?;
                     continue;
                 }
@@ -324,6 +354,7 @@ impl Runner {
                 self.sim.receive(&inbound);
             }
             self.sim.tick();
+            self.port.step(self.sim.now_us())?;
             self.sim.transmit(&mut tx);
             if let Some(link) = self.link.as_mut() {
                 let now = self.sim.now_us();
@@ -350,7 +381,7 @@ impl Runner {
             if last_nxcl.elapsed() > Duration::from_millis(20) {
                 // A host that closed the port left it exclusive; let it (or another) reopen.
                 last_nxcl = Instant::now();
-                let _ = self.pty.allow_reopen();
+                let _ = self.port.allow_reopen();
             }
         }
         if let Some(log) = self.log.as_mut() {
@@ -364,7 +395,7 @@ impl Runner {
         for attempt in 0..2 {
             while !pending.is_empty() {
                 let (a, _) = pending.as_slices();
-                let n = self.pty.write(a)?;
+                let n = self.port.write(a)?;
                 if n == 0 {
                     break;
                 }
@@ -373,7 +404,7 @@ impl Runner {
             if pending.is_empty() || attempt == 1 {
                 break;
             }
-            self.pty.discard_unread()?;
+            self.port.discard_unread()?;
         }
         if pending.len() > MAX_PENDING {
             let excess = pending.len() - MAX_PENDING;

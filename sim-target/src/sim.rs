@@ -54,6 +54,11 @@ pub struct SimOptions {
     pub faults: Option<LinkFaults>,
     /// Run the overhead camera beside the served robot ([`crate::PtySim`] only).
     pub camera: Option<crate::camera::live::LiveCameraOptions>,
+    /// Keep a symlink at this path to the served pty ([`crate::PtySim`] only), as udev keeps
+    /// `/dev/serial/by-id/…`: hosts open it, and it outlives unplugs.
+    pub link: Option<PathBuf>,
+    /// Unplugs of the served port ([`crate::PtySim`] only; needs `link`).
+    pub unplugs: Vec<crate::plug::Unplug>,
 }
 
 impl Default for SimOptions {
@@ -72,6 +77,8 @@ impl Default for SimOptions {
             scene: None,
             faults: None,
             camera: None,
+            link: None,
+            unplugs: Vec::new(),
         }
     }
 }
@@ -120,6 +127,7 @@ pub struct Sim {
     shadow: FrameDecoder,
     session_hello: Option<u16>,
     starts: BTreeMap<u16, u32>,
+    starts_since_boot: BTreeMap<u16, u32>,
     watchdog_trips: u64,
 }
 
@@ -163,6 +171,7 @@ impl Sim {
             shadow: FrameDecoder::new(),
             session_hello: None,
             starts: BTreeMap::new(),
+            starts_since_boot: BTreeMap::new(),
             watchdog_trips: 0,
         })
     }
@@ -203,6 +212,7 @@ impl Sim {
                 && after != before
             {
                 *self.starts.entry(seq).or_insert(0) += 1;
+                *self.starts_since_boot.entry(seq).or_insert(0) += 1;
             }
         }
     }
@@ -211,6 +221,12 @@ impl Sim {
     /// session (the simulator's own count: a primitive executed twice counts 2).
     pub fn starts(&self) -> &BTreeMap<u16, u32> {
         &self.starts
+    }
+
+    /// As [`Sim::starts`], over every session since boot: for a host whose numbering goes on
+    /// across sessions (a recovered link), a number started twice here was executed twice.
+    pub fn starts_since_boot(&self) -> &BTreeMap<u16, u32> {
+        &self.starts_since_boot
     }
 
     /// How many times the link watchdog latched `LINK_LOST` since boot.

@@ -218,3 +218,67 @@ fn binary_runs_a_scene() {
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+#[test]
+fn link_path_follows_the_pty_through_an_unplug() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let link = dir.path().join("ttyPUSHBOT0");
+    let mut child = Process::new(env!("CARGO_BIN_EXE_pushbot-sim"))
+        .args([
+            "--speed",
+            "5",
+            "--no-camera",
+            "--unplug-at",
+            "1",
+            "--unplug-for",
+            "1",
+        ])
+        .arg("--link")
+        .arg(&link)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("start pushbot-sim");
+    let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
+    let mut first = String::new();
+    stdout.read_line(&mut first).expect("first line");
+    let info: serde_json::Value = serde_json::from_str(&first).expect("first line is JSON");
+    assert_eq!(
+        info["serial"].as_str(),
+        link.to_str(),
+        "hosts open the link"
+    );
+    let first_target = std::fs::read_link(&link).expect("a symlink to the pty");
+    // Within a few seconds of wall time (1 s of robot time is 0.2 s at 5×) the path vanishes…
+    let wait = |want: bool| {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while std::fs::symlink_metadata(&link).is_ok() != want {
+            assert!(
+                Instant::now() < deadline,
+                "link present = {want} never came"
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    };
+    wait(false);
+    // …and comes back, naming a pty that exists.
+    wait(true);
+    let second = std::fs::read_link(&link).expect("back");
+    assert!(second.exists(), "{second:?} (was {first_target:?})");
+    drop(child.stdin.take());
+    let status = child.wait().expect("exit");
+    assert!(status.success());
+    assert!(std::fs::symlink_metadata(&link).is_err(), "removed at exit");
+}
+
+#[test]
+fn unplugging_without_a_link_is_refused() {
+    let out = Process::new(env!("CARGO_BIN_EXE_pushbot-sim"))
+        .args(["--no-camera", "--unplug-at", "1"])
+        .stdin(Stdio::null())
+        .output()
+        .expect("run pushbot-sim");
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--link"), "{err}");
+}

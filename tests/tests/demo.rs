@@ -60,3 +60,55 @@ fn an_unknown_stage_or_scene_is_bad_input() {
         }
     }
 }
+
+#[test]
+fn the_rearrangement_reaches_its_goal_through_link_cuts() {
+    // Issue 19: a 1 s cut every 5 s of robot time, the robot's watchdog at 1 s: cuts stop the
+    // robot mid-push or while it stands; each is recovered and the stage still ends at its goal.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("report");
+    let out_s = out.to_str().expect("utf-8");
+    let argv = [
+        "pushbot",
+        "demo",
+        "--out",
+        out_s,
+        "--stages",
+        "rearrange",
+        "--speed",
+        "5",
+        "--faults",
+        "--fault-cut-every",
+        "5",
+        "--fault-cut-for",
+        "1",
+        "--fault-drop",
+        "0",
+        "--fault-corrupt",
+        "0",
+        "--fault-delay-ms",
+        "0",
+    ];
+    let st = run(Cli::try_parse_from(argv).expect("arguments parse")).expect("runs");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("summary.json")).expect("summary.json"),
+    )
+    .expect("summary is JSON");
+    assert_eq!(st, Status::Success, "{summary:#}");
+    let stage = &summary["stages"][0];
+    let recoveries = stage["numbers"]["link_recoveries"]
+        .as_u64()
+        .expect("counted");
+    let mission = stage["mission_s"].as_f64().expect("mission time");
+    eprintln!("{recoveries} recoveries in {mission:.1} s of mission time");
+    assert!(recoveries >= 1, "{summary:#}");
+    let notes = stage["notes"].as_array().expect("notes");
+    let logged = notes
+        .iter()
+        .filter(|n| n.as_str().is_some_and(|s| s.starts_with("link recovered")))
+        .count();
+    assert_eq!(
+        logged as u64, recoveries,
+        "every recovery is logged: {notes:?}"
+    );
+}

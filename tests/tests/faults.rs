@@ -91,3 +91,47 @@ fn moves_complete_despite_drops_corruption_and_cuts() {
     );
     assert!(stats.frames_ok > 100, "{stats:?}");
 }
+
+/// Issue 19: `pushbot-sim --faults --fault-drop 0.01 --fault-corrupt 0.01` — the `--faults`
+/// profile's 20 ms delays and 300 ms cut every 10 s included — and 30 `pushbot robot move` in a
+/// row, each its own session: all 30 complete. A cut longer than the robot's 200 ms watchdog
+/// stops a move; the host recovers the link and sends the rest of the move anew.
+#[test]
+fn thirty_cli_moves_complete_on_a_one_percent_wire() {
+    use clap::Parser;
+    use pushbot::cli::{Cli, Status, run};
+    let faults = LinkFaults {
+        drop: 0.01,
+        corrupt: 0.01,
+        ..LinkFaults::default()
+    };
+    let sim = PtySim::start(SimOptions {
+        seed: 12,
+        // Twice real time: the firmware's own 200 ms watchdog is 100 ms of wall time here.
+        speed: 2.0,
+        start: Pose::new(0.6, 0.45, 0.0),
+        faults: Some(faults),
+        ..SimOptions::default()
+    })
+    .expect("start the simulated robot");
+    let port = sim.serial_path().to_string();
+    let start = sim.truth().pose;
+    for i in 0..30 {
+        let d = if i % 2 == 0 { "0.05" } else { "-0.05" };
+        let argv = [
+            "pushbot",
+            "--json",
+            "robot",
+            "move",
+            "--distance",
+            d,
+            "--port",
+            &port,
+        ];
+        let st = run(Cli::try_parse_from(argv).expect("arguments parse"));
+        assert!(matches!(st, Ok(Status::Success)), "move {i}: {st:?}");
+    }
+    // Back and forth, each move done exactly once: the robot is back where it started.
+    let miss = dist(&sim.truth().pose, &start);
+    assert!(miss < 0.02, "ended {miss} m from the start");
+}

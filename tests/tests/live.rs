@@ -9,7 +9,7 @@ use pushbot_sim::Scene;
 use pushbot_tests::{SIM_SPEED, angle_diff};
 
 fn target(scene: &Scene, seed: u64) -> SimTarget {
-    SimTarget::start(scene, seed, SIM_SPEED, None).expect("start the simulated target")
+    SimTarget::start(scene, seed, SIM_SPEED, None, None).expect("start the simulated target")
 }
 
 /// Options for a target running [`SIM_SPEED`] times faster than real time: a one-second
@@ -129,7 +129,7 @@ fn a_png_frame_of_the_lau_layout_shows_every_marker() {
 
     let scene = Scene::preset("lau-scissors").expect("preset");
     let dir = tempfile::tempdir().expect("temp dir");
-    let t = SimTarget::start(&scene, 6, SIM_SPEED, Some(dir.path().to_path_buf()))
+    let t = SimTarget::start(&scene, 6, SIM_SPEED, Some(dir.path().to_path_buf()), None)
         .expect("start the simulated target");
     let png = dir.path().join("frame-000001.png");
     let end = std::time::Instant::now() + std::time::Duration::from_secs(30);

@@ -24,7 +24,8 @@ fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
     let map = cost_map(&model).expect("map");
     let so = SceneOptions::default();
     let scene = scene_for(&p, &so).expect("scene");
-    let t = SimTarget::start(&scene, 11, SIM_SPEED, None).expect("start the simulated target");
+    let t =
+        SimTarget::start(&scene, 11, SIM_SPEED, None, None).expect("start the simulated target");
     let opts = LiveOptions {
         watchdog_ms: (1000.0 * SIM_SPEED) as u16,
         boundary_inset: 0.0,

@@ -19,7 +19,8 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     );
     let scene = Scene::preset("lau-irregular").expect("preset");
     let goal = scene.goals[0].pose;
-    let t = SimTarget::start(&scene, 21, SIM_SPEED, None).expect("start the simulated target");
+    let t =
+        SimTarget::start(&scene, 21, SIM_SPEED, None, None).expect("start the simulated target");
     let watchdog = ((1000.0 * SIM_SPEED) as u16).to_string();
     let argv = [
         "pushbot",

@@ -6,12 +6,12 @@ use std::time::Duration;
 
 use pushbot::link::LinkError;
 use pushbot_protocol::{Faults, NackReason, Outcome};
-use pushbot_tests::{connect, sim_at, wait_truth};
+use pushbot_tests::{connect_strict, sim_at, wait_truth};
 
 #[test]
 fn motors_stop_within_250_ms_after_the_host_goes_silent() {
     let sim = sim_at(5, 0.3, 0.45, 0.0);
-    let mut robot = connect(&sim);
+    let mut robot = connect_strict(&sim);
     let motion = robot.velocity(0.05, 0.0, Duration::from_secs(20)).unwrap();
     let moving = wait_truth(&sim, Duration::from_secs(5), |t| t.duty[0].abs() > 0.05)
         .expect("the robot starts driving");
@@ -59,7 +59,7 @@ fn motors_stop_within_250_ms_after_the_host_goes_silent() {
 fn vanished_port_is_a_clean_error() {
     let sim = sim_at(6, 0.6, 0.45, 0.0);
     let path = sim.serial_path().to_string();
-    let robot = connect(&sim);
+    let robot = connect_strict(&sim);
     robot.wait_telemetry(None).unwrap();
     sim.shutdown().unwrap();
     let err = robot.wait_telemetry(Some(u64::MAX - 1)).unwrap_err();

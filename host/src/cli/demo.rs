@@ -30,7 +30,7 @@ pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
 /// `pushbot demo`.
 #[derive(Args, Debug, Clone)]
 #[command(
-    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml"
+    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml --reconnect 10\n  pushbot demo --stages strategy --faults --fault-cut-every 5 --fault-cut-for 1"
 )]
 pub struct DemoArgs {
     /// Folder for the report (created; files in it are replaced).
@@ -67,6 +67,11 @@ pub struct DemoArgs {
     /// with detected markers, tracked poses and the current path, refreshed after every look).
     #[arg(long)]
     pub view: bool,
+    /// Link faults between the host and the built-in simulated target (as `pushbot-sim`
+    /// takes them), e.g. `--faults --fault-cut-every 5 --fault-cut-for 1`.
+    #[cfg(feature = "sim")]
+    #[command(flatten)]
+    pub faults: crate::sim::target::FaultArgs,
 }
 
 /// The scene a stage runs on: `--scene STAGE=…` or the default.
@@ -143,6 +148,12 @@ fn run_stages(
     stable_name: String,
 ) -> CliResult {
     use crate::experiments::demo::{DemoOptions, run};
+    let faults = args.faults.link_faults().map_err(CliError::bad_input)?;
+    if faults.is_some() && args.port.is_some() {
+        return Err(CliError::bad_input(
+            "--faults injects faults on the built-in simulated target's link, not with --port",
+        ));
+    }
     let opts = DemoOptions {
         out: args.out.clone(),
         stages: args.stages.clone(),
@@ -156,6 +167,9 @@ fn run_stages(
         cache: args.cache.clone(),
         view: args.view,
         quiet: g.json,
+        faults,
+        link: g.link_options()?,
+        recover: !g.no_recover,
     };
     let t0 = Instant::now();
     if args.view && !g.json {

@@ -26,6 +26,23 @@ pub struct BenchLinkArgs {
     /// Probability that a garbage byte is inserted before a byte, each direction.
     #[arg(long, value_name = "P", default_value_t = 0.0)]
     pub garbage: f64,
+    /// Cut the wire (both ways) every this many seconds of robot time; each cut is recovered
+    /// (a new session, the link's fault cleared) and counted.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub cut_every: f64,
+    /// How long each cut lasts, s of robot time.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub cut_for: f64,
+}
+
+fn seconds(name: &str, s: f64) -> Result<f64, CliError> {
+    if s.is_finite() && (0.0..1e6).contains(&s) {
+        Ok(s)
+    } else {
+        Err(CliError::bad_input(format!(
+            "--{name} must be a time in seconds ≥ 0, not {s}"
+        )))
+    }
 }
 
 fn probability(name: &str, p: f64) -> Result<f64, CliError> {
@@ -50,6 +67,8 @@ pub fn run(g: &Global, a: &BenchLinkArgs) -> CliResult {
         duplicate: probability("duplicate", a.duplicate)?,
         drop: probability("drop", a.drop)?,
         garbage: probability("garbage", a.garbage)?,
+        cut_every_s: seconds("cut-every", a.cut_every)?,
+        cut_for_s: seconds("cut-for", a.cut_for)?,
         seed: g.seed,
         ..LinkBenchOptions::default()
     };

@@ -34,6 +34,30 @@ pub struct Global {
     /// More log output (-v info, -vv debug, -vvv trace). Logs go to stderr.
     #[arg(short, long, global = true, action = clap::ArgAction::Count)]
     pub verbose: u8,
+    /// When the robot's serial port goes away (a USB re-enumeration), wait this many seconds of
+    /// wall time for it to come back and go on; without it, a vanished port is an error at once.
+    #[arg(long, global = true, value_name = "SECONDS")]
+    pub reconnect: Option<f64>,
+    /// Do not recover a broken link (a cut, a vanished port): end the task with an error
+    /// instead of reconnecting, clearing the link's fault and going on from the measured pose.
+    #[arg(long, global = true)]
+    pub no_recover: bool,
+}
+
+impl Global {
+    /// The serial link's settings these flags ask for.
+    pub fn link_options(&self) -> Result<crate::robot::LinkOptions, CliError> {
+        let mut o = crate::robot::LinkOptions::default();
+        if let Some(s) = self.reconnect {
+            if !(s.is_finite() && (0.0..=86_400.0).contains(&s)) {
+                return Err(CliError::bad_input(format!(
+                    "--reconnect must be a number of seconds in 0..=86400, not {s}"
+                )));
+            }
+            o.reconnect_timeout = std::time::Duration::from_secs_f64(s);
+        }
+        Ok(o)
+    }
 }
 
 /// pushbot: a small differential-drive robot that rearranges and delivers objects by pushing.

@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 
 use super::{CliError, CliResult, Global, Status};
 use crate::link::{FaultNames, LinkError};
-use crate::robot::{DoneReport, LinkOptions, Robot};
+use crate::robot::{DoneReport, Robot};
 
 /// `pushbot robot`: the robot's commands and how to reach it.
 #[derive(Args, Debug)]
@@ -97,16 +97,7 @@ fn positive(name: &str, v: f64) -> Result<f32, CliError> {
     }
 }
 
-/// The lower-case name of an outcome, as printed.
-pub fn outcome_name(o: Outcome) -> String {
-    match o {
-        Outcome::Completed => "completed".into(),
-        Outcome::Contact => "contact".into(),
-        Outcome::Aborted => "aborted".into(),
-        Outcome::Fault(f) => format!("fault ({})", FaultNames(f)),
-        Outcome::Timeout => "timeout".into(),
-    }
-}
+pub use crate::robot::outcome_name;
 
 fn mode_name(m: Mode) -> &'static str {
     match m {
@@ -231,10 +222,11 @@ pub fn run(global: &Global, args: RobotArgs) -> CliResult {
     };
     let target = Target::open(&args, global.seed)?;
     let result = (|| {
-        let robot = Robot::connect(&target.path, LinkOptions::default()).map_err(link_error)?;
+        let mut robot = Robot::connect(&target.path, global.link_options()?).map_err(link_error)?;
         let simulated = target.simulated();
+        let port_path = robot.path().to_string();
         let base =
-            |name: &str| json!({ "command": name, "port": robot.path(), "simulated": simulated });
+            |name: &str| json!({ "command": name, "port": port_path, "simulated": simulated });
         match args.cmd {
             RobotCmd::Info => {
                 let info = robot.info().map_err(link_error)?;
@@ -285,14 +277,21 @@ pub fn run(global: &Global, args: RobotArgs) -> CliResult {
                 Ok(Status::Success)
             }
             RobotCmd::Move { .. } | RobotCmd::Spin { .. } => {
-                let (name, done, contact_ok) = if let Some((d, s, soc)) = parsed {
-                    ("move", robot.move_distance(d, s, soc), soc)
+                use crate::exec::primitive::{Primitive, run_primitive};
+                let (name, p, contact_ok) = if let Some((d, s, soc)) = parsed {
+                    let p = Primitive::Move {
+                        distance: d,
+                        speed: s,
+                        stop_on_contact: soc,
+                    };
+                    ("move", p, soc)
                 } else if let Some((a, r)) = spin {
-                    ("spin", robot.spin(a, r), false)
+                    ("spin", Primitive::Spin { angle: a, rate: r }, false)
                 } else {
                     return Err(CliError::bad_input("internal: no motion arguments"));
                 };
-                let done: DoneReport = done.map_err(link_error)?;
+                let end = run_primitive(&mut robot, p, !global.no_recover).map_err(link_error)?;
+                let done: DoneReport = end.done;
                 let ok = done.outcome == Outcome::Completed
                     || (contact_ok && done.outcome == Outcome::Contact);
                 if global.json {
@@ -303,6 +302,7 @@ pub fn run(global: &Global, args: RobotArgs) -> CliResult {
                     v["duration_s"] = json!(done.duration_s);
                     v["time_s"] = json!(done.time_us as f64 / 1e6);
                     v["odometry"] = pose_json(done.pose);
+                    v["recoveries"] = json!(end.recoveries);
                     println!("{v}");
                 } else {
                     println!(
@@ -311,6 +311,12 @@ pub fn run(global: &Global, args: RobotArgs) -> CliResult {
                         done.duration_s
                     );
                     println!("{}", pose_text(done.pose));
+                    for r in &end.recoveries {
+                        println!(
+                            "link recovered at robot time {:.1} s ({}); the rest was sent anew",
+                            r.robot_time_s, r.cause
+                        );
+                    }
                 }
                 Ok(if ok {
                     Status::Success

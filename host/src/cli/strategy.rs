@@ -86,6 +86,8 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
         boundary_inset,
         object: a.object.clone(),
         watchdog_ms: a.watchdog_ms,
+        link: global.link_options()?,
+        recover: !global.no_recover,
         ..LiveOptions::default()
     };
     let mut io = LiveRobot::connect(port, camera, scene, opts).map_err(CliError::Failed)?;
@@ -107,10 +109,49 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
                 seed: global.seed,
                 ..CollectParams::default()
             };
-            let mut strategy = PushStrategy::new(Vec::new(), kernel);
+            // With --strategy-dir every sample is written as it is collected: a collection cut
+            // short (a link that did not come back, a person stopping it) keeps what it had, and
+            // the next run goes on from there.
+            let mut writer = match &a.strategy_dir {
+                Some(dir) => {
+                    std::fs::create_dir_all(dir).map_err(|e| {
+                        CliError::bad_input(format!("cannot create {}: {e}", dir.display()))
+                    })?;
+                    let id = a
+                        .object
+                        .clone()
+                        .or_else(|| scene.objects.first().map(|o| o.id.clone()))
+                        .ok_or_else(|| {
+                            CliError::bad_input(format!("scene {} has no object", scene.name))
+                        })?;
+                    let file =
+                        dir.join(format!("{}.strategy", scene.name.replace(['/', '.'], "_")));
+                    Some(
+                        store::StrategyWriter::open(&file, &id)
+                            .map_err(|e| CliError::bad_input(e.to_string()))?,
+                    )
+                }
+                None => None,
+            };
+            let existing = writer.as_mut().map(|(_, s)| std::mem::take(s));
+            let mut strategy = PushStrategy::new(existing.unwrap_or_default(), kernel);
             let pb = progress_bar(global, params.initial as u64);
-            let rep = collect(&mut io, &mut strategy, &params, &mut |_| Ok(()), &pb)?;
+            let mut sink = |s: &Sample| -> anyhow::Result<()> {
+                if let Some((w, _)) = writer.as_mut() {
+                    w.append(s)?;
+                }
+                Ok(())
+            };
+            let rep = collect(&mut io, &mut strategy, &params, &mut sink, &pb);
             pb.finish_and_clear();
+            let rep = rep.map_err(|e| match &writer {
+                Some((w, _)) => CliError::Failed(e.context(format!(
+                    "collection stopped; the {} samples collected so far are kept in {}",
+                    strategy.samples().len(),
+                    w.path().display()
+                ))),
+                None => CliError::Failed(e),
+            })?;
             collection = Some(rep);
             strategy.samples().to_vec()
         }
@@ -159,6 +200,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
                     "collection": collection,
                     "results": [res],
                 }],
+                "recoveries": io.recoveries(),
             })
         );
     } else {
@@ -172,6 +214,12 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
             runs.last()
                 .map_or("-".into(), |d| format!("{:.3} m", d.final_distance)),
         );
+        for r in io.recoveries() {
+            println!(
+                "link recovered at robot time {:.1} s ({}), {:.2} s",
+                r.robot_time_s, r.cause, r.wall_s
+            );
+        }
     }
     Ok(if res.success_rate >= 95.0 {
         Status::Success

@@ -18,7 +18,8 @@ use pushbot_world::Scene;
 
 use super::grabber::FrameGrabber;
 use crate::exec::io::{Rect, RobotIo, Workspace};
-use crate::robot::{LinkOptions, Robot};
+use crate::link::LinkError;
+use crate::robot::{LinkOptions, Recovery, Robot, link_broke};
 use crate::strategy::sample::Pose2;
 use crate::vision::Pipeline;
 use crate::vision::calibration::Calibration;
@@ -58,8 +59,12 @@ pub struct LiveOptions {
     /// Keep a live view (camera image, detections, tracked poses) in this folder
     /// ([`super::view`]).
     pub view_dir: Option<std::path::PathBuf>,
-    /// The serial link's settings.
+    /// The serial link's settings (`reconnect_timeout`: how long to wait for a port that went
+    /// away).
     pub link: LinkOptions,
+    /// Recover from a broken link ([`Robot::recover`]) and go on from the measured pose; off
+    /// (`--no-recover`), a broken link ends the task with an error.
+    pub recover: bool,
 }
 
 impl Default for LiveOptions {
@@ -77,6 +82,7 @@ impl Default for LiveOptions {
             watchdog_ms: 1000,
             view_dir: None,
             link: LinkOptions::default(),
+            recover: true,
         }
     }
 }
@@ -105,6 +111,8 @@ pub struct LiveRobot {
     host_adjust: f64,
     frames_seen: u64,
     view: Option<super::view::LiveView>,
+    /// Recoveries since the last motion that ran to its end.
+    recoveries_in_a_row: usize,
 }
 
 impl std::fmt::Debug for LiveRobot {
@@ -196,6 +204,7 @@ impl LiveRobot {
             host_adjust: 0.0,
             frames_seen: 0,
             view,
+            recoveries_in_a_row: 0,
             opts,
         };
         live.look()?;
@@ -221,6 +230,11 @@ impl LiveRobot {
     /// The live view, if one is kept: set its `plan` to draw a path.
     pub fn view_mut(&mut self) -> Option<&mut super::view::LiveView> {
         self.view.as_mut()
+    }
+
+    /// Every recovery of the link so far, in order.
+    pub fn recoveries(&self) -> Vec<Recovery> {
+        self.robot.recoveries()
     }
 
     /// Frames processed so far.
@@ -289,8 +303,14 @@ impl LiveRobot {
     }
 
     /// Run one motion to its end; a fault it ended in (a stall against something that does not
-    /// move) is cleared and the motion counts as ended, as the strategy expects.
-    fn motion(&mut self, what: &str, run: impl Fn(&Robot) -> Result<Outcome>) -> Result<()> {
+    /// move) is cleared and the motion counts as ended, as the strategy expects. A broken link
+    /// is recovered ([`Robot::recover`]) and the motion counts as ended too: the executor looks
+    /// again and goes on from where the robot really is.
+    fn motion(
+        &mut self,
+        what: &'static str,
+        run: impl Fn(&Robot) -> Result<Outcome>,
+    ) -> Result<()> {
         if let Some(e) = &self.camera_error {
             bail!("the camera stopped: {e}");
         }
@@ -309,35 +329,75 @@ impl LiveRobot {
         out
     }
 
-    fn run_motion(&mut self, what: &str, run: impl Fn(&Robot) -> Result<Outcome>) -> Result<()> {
+    fn run_motion(
+        &mut self,
+        what: &'static str,
+        run: impl Fn(&Robot) -> Result<Outcome>,
+    ) -> Result<()> {
         // A refused command never started: clear the faults and send it again, a few times (a
         // loaded host can let the link watchdog fire again between the clear and the retry).
         const ATTEMPTS: usize = 4;
         for attempt in 0..ATTEMPTS {
             match run(&self.robot) {
                 Ok(Outcome::Fault(f)) if f.contains(pushbot_protocol::Faults::LINK_LOST) => {
-                    self.clear_faults()?;
-                    bail!(
-                        "{what} on {} was cut short: the robot's link watchdog fired ({}); the \
-                         host was too slow to keep the link alive",
+                    let cause = format!(
+                        "{what} on {} was cut short: the robot's link watchdog fired ({})",
                         self.robot.path(),
                         crate::link::FaultNames(f)
                     );
+                    return self.recover_link(what, cause);
                 }
                 Ok(Outcome::Fault(f)) => {
                     tracing::debug!("{what} ended in fault {}", crate::link::FaultNames(f));
                     self.clear_faults()?;
+                    self.recoveries_in_a_row = 0;
                     return Ok(());
                 }
-                Ok(_) => return Ok(()),
-                Err(e) if attempt + 1 < ATTEMPTS && is_faulted_refusal(&e) => {
+                Ok(_) => {
+                    self.recoveries_in_a_row = 0;
+                    return Ok(());
+                }
+                Err(e) if attempt + 1 < ATTEMPTS && faulted_refusal(&e) == Some(LINK_ONLY) => {
+                    // The link broke while the robot stood (its watchdog fired between two
+                    // primitives): recover, then send the refused motion again — it never ran.
+                    let cause = format!("{what} on {}: {e:#}", self.robot.path());
+                    self.recover_link(what, cause)?;
+                }
+                Err(e) if attempt + 1 < ATTEMPTS && faulted_refusal(&e).is_some() => {
                     tracing::debug!("{what} refused ({e:#}); clearing the faults and retrying");
                     self.clear_faults()?;
+                }
+                Err(e) if e.downcast_ref::<LinkError>().is_some_and(link_broke) => {
+                    let cause = format!("{what} on {}: {e:#}", self.robot.path());
+                    return self.recover_link(what, cause);
                 }
                 Err(e) => return Err(e.context(format!("{what} on {}", self.robot.path()))),
             }
         }
         bail!("the robot stayed faulted")
+    }
+
+    /// The link broke during `what`: recover it, or say why not.
+    fn recover_link(&mut self, what: &'static str, cause: String) -> Result<()> {
+        /// Recoveries in a row (no motion ending in between) before giving up.
+        const MOST_IN_A_ROW: usize = 5;
+        if !self.opts.recover {
+            bail!("{cause} (recovery is off: --no-recover)");
+        }
+        if self.recoveries_in_a_row >= MOST_IN_A_ROW {
+            bail!("{cause}; the link broke {MOST_IN_A_ROW} times in a row: giving up");
+        }
+        self.recoveries_in_a_row += 1;
+        let seq = self.robot.last_seq();
+        let command = match what {
+            "spin" => "Spin",
+            "move" => "Move",
+            _ => "Velocity",
+        };
+        self.robot
+            .recover(&cause, Some((seq, command)))
+            .with_context(|| format!("recovering the link after: {cause}"))?;
+        Ok(())
     }
 
     fn clear_faults(&mut self) -> Result<()> {
@@ -353,14 +413,18 @@ impl LiveRobot {
     }
 }
 
-fn is_faulted_refusal(e: &anyhow::Error) -> bool {
-    matches!(
-        e.downcast_ref::<crate::link::LinkError>(),
-        Some(crate::link::LinkError::Refused {
-            reason: crate::link::Refusal(pushbot_protocol::NackReason::Faulted(_)),
+/// Only the link's own fault.
+const LINK_ONLY: pushbot_protocol::Faults = pushbot_protocol::Faults::LINK_LOST;
+
+/// The faults a refusal names, when `e` is a refusal for latched faults.
+fn faulted_refusal(e: &anyhow::Error) -> Option<pushbot_protocol::Faults> {
+    match e.downcast_ref::<LinkError>() {
+        Some(LinkError::Refused {
+            reason: crate::link::Refusal(pushbot_protocol::NackReason::Faulted(f)),
             ..
-        })
-    )
+        }) => Some(*f),
+        _ => None,
+    }
 }
 
 /// Fit the camera's calibration from a few frames of the scene's calibration markers.

@@ -8,6 +8,8 @@
 //! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals;
 //! - [`rearrange`]: Ben-Shahar & Rivlin's plans driven with re-observation and snapping;
 //! - [`stable`]: Lynch & Mason's stable pushes on the plated robot, with transits;
+//! - [`primitive`]: one motion primitive as a task, resumed from the odometry through link
+//!   breaks (`pushbot robot move`);
 //! - [`live`]: the [`RobotIo`](crate::exec::io::RobotIo) over a real serial link
 //!   and a real camera: the same code runs a robot on a table and the simulated target, which
 //!   it cannot tell apart.
@@ -19,6 +21,7 @@ pub mod grabber;
 pub mod io;
 pub mod live;
 pub mod maneuver;
+pub mod primitive;
 pub mod rearrange;
 pub mod record;
 pub mod stable;

@@ -20,7 +20,9 @@ use crate::exec::record::{Recorder, TracePoint, TruthProbe};
 use crate::exec::{LiveOptions, LiveRobot};
 use crate::planner::rearrange::Problem as RearrangeProblem;
 use crate::report::{Report, StageReport, figure};
+use crate::robot::{LinkOptions, Recovery};
 use crate::sim::SimTarget;
+use crate::sim::target::LinkFaults;
 use crate::strategy::sample::Pose2;
 
 /// The stages, in the order they run.
@@ -53,6 +55,13 @@ pub struct DemoOptions {
     pub view: bool,
     /// No progress bars (`--json`).
     pub quiet: bool,
+    /// Link faults injected between the host and the built-in simulated target (not with a
+    /// real robot).
+    pub faults: Option<LinkFaults>,
+    /// The serial link's settings (how long to wait for a port that went away).
+    pub link: LinkOptions,
+    /// Recover a broken link and go on (`--no-recover` turns it off).
+    pub recover: bool,
 }
 
 /// Run the demo's stages into a report; a stage that fails is recorded as failed and the next
@@ -61,7 +70,12 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
     let report = Report::create(&opts.out, "pushbot demo", opts.png)?;
     let log = std::fs::File::create(opts.out.join("demo.log"))
         .map_err(|e| anyhow!("creating demo.log: {e}"))?;
-    let mut ctx = Ctx { opts, report, log };
+    let mut ctx = Ctx {
+        opts,
+        report,
+        log,
+        recoveries: Vec::new(),
+    };
     for stage in &opts.stages {
         let started = std::time::Instant::now();
         let result = match stage.as_str() {
@@ -78,6 +92,11 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
             }
         };
         rep.wall_s = started.elapsed().as_secs_f64();
+        let recoveries = std::mem::take(&mut ctx.recoveries);
+        rep.number("link_recoveries", recoveries.len());
+        for r in &recoveries {
+            rep.notes.push(recovery_note(r));
+        }
         ctx.log(&format!(
             "stage {stage}: {} in {:.1} s wall, {:.1} s mission time",
             if rep.success { "reached" } else { "FAILED" },
@@ -93,11 +112,29 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
     Ok((ctx.report, page))
 }
 
+/// One line for the report on a recovery of the link.
+fn recovery_note(r: &Recovery) -> String {
+    let what = r.interrupted.as_ref().map_or(String::new(), |i| {
+        format!(
+            "; {} #{} {}",
+            i.command,
+            i.seq,
+            i.outcome.as_deref().unwrap_or("outcome unknown")
+        )
+    });
+    format!(
+        "link recovered at robot time {:.1} s in {:.2} s ({}{what})",
+        r.robot_time_s, r.wall_s, r.cause
+    )
+}
+
 /// Everything a stage needs.
 struct Ctx<'a> {
     opts: &'a DemoOptions,
     report: Report,
     log: std::fs::File,
+    /// Recoveries of the link during the stage running.
+    recoveries: Vec<Recovery>,
 }
 
 impl Ctx<'_> {
@@ -136,19 +173,31 @@ impl Ctx<'_> {
         };
         let opts = LiveOptions {
             object: object.map(str::to_owned),
-            watchdog_ms: (1000.0 * speed.max(1.0)).min(5000.0) as u16,
+            // With link faults injected the watchdog is the real robot's (1 s of robot time),
+            // so that a cut stops the robot as it would on the table; otherwise it grows with
+            // the simulation's speed (the host's threads get less wall time per robot second).
+            watchdog_ms: if self.opts.faults.is_some() {
+                1000
+            } else {
+                (1000.0 * speed.max(1.0)).min(5000.0) as u16
+            },
             view_dir: self.opts.view.then(|| self.opts.out.join("live")),
+            link: self.opts.link.clone(),
+            recover: self.opts.recover,
             ..LiveOptions::default()
         };
         match &self.opts.robot {
             Some((port, camera)) => {
                 let mut live = LiveRobot::connect(port, camera, scene, opts)?;
                 let mut rec = Recorder::new(&mut live, ids, None);
-                let out = f(&mut rec)?;
-                Ok((out, rec.into_trace()))
+                let out = f(&mut rec);
+                let trace = rec.into_trace();
+                self.recoveries.extend(live.recoveries());
+                Ok((out?, trace))
             }
             None => {
-                let target = SimTarget::start(scene, self.opts.seed, speed, None)?;
+                let target =
+                    SimTarget::start(scene, self.opts.seed, speed, None, self.opts.faults)?;
                 self.log(&format!(
                     "simulated target: serial {} camera {}",
                     target.port(),
@@ -168,7 +217,9 @@ impl Ctx<'_> {
                     });
                     let mut rec = Recorder::new(&mut live, ids, Some(probe));
                     let out = f(&mut rec);
-                    out.map(|o| (o, rec.into_trace()))
+                    let trace = rec.into_trace();
+                    self.recoveries.extend(live.recoveries());
+                    out.map(|o| (o, trace))
                 };
                 target.shutdown()?;
                 result

@@ -3,7 +3,8 @@
 //!
 //! Every number is in robot (simulated) time except the wall time. What the robot executed is
 //! read from the simulator's own count of started primitives per sequence number
-//! ([`pushbot_sim::Sim::starts`]), not from what the host believes:
+//! ([`pushbot_sim::Sim::starts_since_boot`]: every session, as the host's numbering goes on
+//! across recoveries), not from what the host believes:
 //!
 //! * `executed_twice`: motion commands the robot started more than once;
 //! * `unasked_motions`: primitives started under a sequence number the host never used for a
@@ -12,9 +13,12 @@
 //!
 //! Outcomes, as the host knows them: `completed` (a motion's `Done(Completed)`, a stop or query
 //! acknowledged), `refused` (a `Nack`), `failed` (a motion that ended otherwise: fault, timeout,
-//! aborted), `unknown` (no answer, or no end, before the client gave up). A latched `LINK_LOST`
-//! seen in the telemetry is cleared (`ClearFaults`) and counted as a recovery. `latency_ms` is
-//! the robot time from sending a command to its answer (`Ack`/`Nack`), retries included.
+//! aborted), `unknown` (no answer, or no end, before the client gave up, and the robot's report
+//! after the recovery does not name it). A broken link (no answer, silence) or a latched
+//! `LINK_LOST` is recovered with [`Robot::recover`] — a new session, the link's fault cleared —
+//! and counted; the interrupted command's fate is then what the robot reports for it. With
+//! `cut_every_s`, the wire is also cut periodically (both ways). `latency_ms` is the robot time
+//! from sending a command to its answer (`Ack`/`Nack`), retries included.
 
 use std::collections::BTreeSet;
 use std::time::Instant;
@@ -28,7 +32,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::link::{Driver, LinkError};
-use crate::robot::{LinkOptions, Robot, motion_budget_us};
+use crate::robot::{LinkOptions, Robot, command_name, link_broke, motion_budget_us};
 use crate::sim::inprocess::InProcess;
 
 /// What to run.
@@ -46,6 +50,10 @@ pub struct LinkBenchOptions {
     pub drop: f64,
     /// Per byte, each direction: probability that a garbage byte is inserted before it.
     pub garbage: f64,
+    /// Cut the wire every this many seconds of robot time (0: never)…
+    pub cut_every_s: f64,
+    /// …for this long, s.
+    pub cut_for_s: f64,
     /// Seed of the simulator, the fault pipe and the command mix.
     pub seed: u64,
     /// Link settings of the host.
@@ -62,6 +70,8 @@ impl Default for LinkBenchOptions {
             duplicate: 0.0,
             drop: 0.0,
             garbage: 0.0,
+            cut_every_s: 0.0,
+            cut_for_s: 0.0,
             seed: 0,
             link: LinkOptions::default(),
         }
@@ -98,7 +108,7 @@ pub struct LinkBenchReport {
     pub motions_started: usize,
     /// Times the robot's link watchdog latched `LINK_LOST`.
     pub watchdog_trips: u64,
-    /// Latched `LINK_LOST` faults cleared by the bench.
+    /// Recoveries of the link ([`Robot::recover`]).
     pub recoveries: usize,
     /// Command frames resent, per command sent.
     pub retries_per_command: f64,
@@ -140,8 +150,12 @@ enum Fate {
     Unknown,
 }
 
-fn fate_of(e: &LinkError) -> Fate {
+/// The fate of a command that ended in `e`; a broken link is noted in `broke`.
+fn fate_of(e: &LinkError, broke: &mut Option<String>) -> Fate {
     tracing::info!("command not completed: {e}");
+    if link_broke(e) {
+        *broke = Some(e.to_string());
+    }
     match e {
         LinkError::Refused { .. } => Fate::Refused,
         _ => Fate::Unknown,
@@ -173,21 +187,21 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
         frame_loss: opts.frame_loss,
         duplicate: opts.duplicate,
         max_delay_us: 0,
-        cut_every_us: 0,
-        cut_for_us: 0,
+        cut_every_us: (opts.cut_every_s.max(0.0) * 1e6) as u64,
+        cut_for_us: (opts.cut_for_s.max(0.0) * 1e6) as u64,
     };
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     rng.set_stream(7);
     let first_seq: u16 = rng.random();
     let driver =
         InProcess::with_faults(sim, opts.link.client_options(first_seq), faults, opts.seed);
-    let robot = Robot::over(driver, opts.link.clone())?;
+    let mut robot = Robot::over(driver, opts.link.clone())?;
     let now_us = |r: &Robot<InProcess>| r.driver().sim().now_us();
     let start_us = now_us(&robot);
 
     let mut motions = BTreeSet::new();
     let mut latencies = Vec::with_capacity(opts.commands);
-    let (mut completed, mut refused, mut failed, mut unknown, mut recoveries) = (0, 0, 0, 0, 0);
+    let (mut completed, mut refused, mut failed, mut unknown) = (0, 0, 0, 0);
     // Moves and spins each go back and forth: the robot stays where it started.
     let (mut forth, mut left) = (1.0f32, 1.0f32);
     for _ in 0..opts.commands {
@@ -212,6 +226,7 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
         };
         let seq = robot.driver().inspect(|c| c.next_seq());
         let sent_us = now_us(&robot);
+        let mut broke = None;
         let fate = if motion_budget_us(&cmd).is_some() {
             motions.insert(seq);
             match robot.start(cmd) {
@@ -221,16 +236,21 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
                         Ok(d) if d.outcome == Outcome::Completed => Fate::Completed,
                         Ok(d) => {
                             tracing::info!("#{seq} ended {:?}", d.outcome);
+                            if let Outcome::Fault(f) = d.outcome
+                                && f.contains(Faults::LINK_LOST)
+                            {
+                                broke = Some("the robot's link watchdog fired".to_string());
+                            }
                             Fate::Failed
                         }
-                        Err(e) => fate_of(&e),
+                        Err(e) => fate_of(&e, &mut broke),
                     }
                 }
                 Err(e) => {
                     if matches!(e, LinkError::Refused { .. }) {
                         latencies.push(now_us(&robot) - sent_us);
                     }
-                    fate_of(&e)
+                    fate_of(&e, &mut broke)
                 }
             }
         } else {
@@ -240,8 +260,27 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
             }
             match answered {
                 Ok(_) => Fate::Completed,
-                Err(e) => fate_of(&e),
+                Err(e) => fate_of(&e, &mut broke),
             }
+        };
+        if broke.is_none()
+            && robot
+                .telemetry()
+                .is_some_and(|t| t.faults.contains(Faults::LINK_LOST))
+        {
+            broke = Some("the robot latched LINK_LOST".to_string());
+        }
+        let fate = match broke {
+            Some(cause) => {
+                let rec = robot.recover(&cause, Some((seq, command_name(&cmd))))?;
+                let reported = rec.interrupted.and_then(|i| i.outcome);
+                match (fate, reported.as_deref()) {
+                    (Fate::Unknown, Some("completed")) => Fate::Completed,
+                    (Fate::Unknown, Some(_)) => Fate::Failed,
+                    (f, _) => f,
+                }
+            }
+            None => fate,
         };
         match fate {
             Fate::Completed => completed += 1,
@@ -249,20 +288,12 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
             Fate::Failed => failed += 1,
             Fate::Unknown => unknown += 1,
         }
-        if robot
-            .telemetry()
-            .is_some_and(|t| t.faults.contains(Faults::LINK_LOST))
-        {
-            tracing::info!("link watchdog tripped; clearing LINK_LOST");
-            if robot.clear_faults().is_ok() {
-                recoveries += 1;
-            }
-        }
     }
 
     let stats = robot.stats();
     let sim = robot.driver().sim();
-    let starts = sim.starts();
+    // Numbering goes on across recovered sessions: count over all of them.
+    let starts = sim.starts_since_boot();
     let executed_twice = starts
         .iter()
         .filter(|&(seq, &n)| motions.contains(seq) && n > 1)
@@ -286,7 +317,7 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
         unasked_motions,
         motions_started: starts.len(),
         watchdog_trips: sim.watchdog_trips(),
-        recoveries,
+        recoveries: robot.recoveries().len(),
         retries_per_command: stats.retries as f64 / opts.commands.max(1) as f64,
         latency_ms: Latency {
             p50: pct(0.5),

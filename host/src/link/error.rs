@@ -87,6 +87,33 @@ pub enum LinkError {
         /// Its budget, s of robot time.
         budget_s: f64,
     },
+    /// The port went away and did not come back in time (a USB re-enumeration that took longer,
+    /// a robot unplugged).
+    #[error(
+        "the serial port {path} went away and did not come back{}: {reason}; give \
+         --reconnect SECONDS to wait for it",
+        if *waited_s > 0.05 { format!(" within {waited_s:.1} s") } else { String::new() }
+    )]
+    Vanished {
+        /// The port's path.
+        path: String,
+        /// How long the host waited for it, s of wall time.
+        waited_s: f64,
+        /// The last error opening it.
+        reason: String,
+    },
+    /// The link came back but the robot holds faults that only the user may clear.
+    #[error(
+        "the link to {path} is back, but the robot holds {}: recovery clears only the link's \
+         own fault; check the robot, then run `pushbot robot clear-faults`",
+        FaultNames(*faults)
+    )]
+    RecoveryRefused {
+        /// The port's path.
+        path: String,
+        /// The faults latched besides `LINK_LOST`.
+        faults: Faults,
+    },
     /// An argument the host can already tell is wrong (not finite, wrong sign).
     #[error("invalid argument: {0}")]
     InvalidArgument(String),

@@ -18,6 +18,7 @@
 //! # Ok::<(), pushbot::link::LinkError>(())
 //! ```
 
+mod recover;
 mod types;
 
 #[cfg(test)]
@@ -25,7 +26,7 @@ mod tests;
 
 use std::sync::mpsc;
 use std::sync::{Mutex, MutexGuard};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use pushbot_protocol::{
     Command, ConfigUpdate, ContactEvent, Faults, FirmwareVersion, Geometry, HelloReply, Mode, Pose,
@@ -36,6 +37,7 @@ use crate::link::{
     Answer, Driver, Handshake, LinkError, LinkStats, MotionEnd, Refusal, RobotEvent, SerialDriver,
 };
 
+pub use recover::{Interrupted, Recovery, link_broke, outcome_name};
 pub use types::{DoneReport, LinkOptions, Motion, RobotInfo, command_name, motion_budget_us};
 
 /// A connection to a robot running pushbot firmware (or the simulator), over a driver of the
@@ -46,6 +48,10 @@ pub struct Robot<D: Driver = SerialDriver> {
     hello: HelloReply,
     /// Holding the lock is holding the right to have a command in flight.
     in_flight: Mutex<()>,
+    /// Every recovery of the link so far ([`Robot::recover`]).
+    recoveries: Mutex<Vec<Recovery>>,
+    /// Link counters of the sessions before the current one.
+    past_stats: LinkStats,
 }
 
 fn check_finite(what: &str, values: &[(&str, f32)]) -> Result<(), LinkError> {
@@ -89,6 +95,8 @@ impl<D: Driver> Robot<D> {
             driver,
             hello: placeholder_hello(),
             in_flight: Mutex::new(()),
+            recoveries: Mutex::new(Vec::new()),
+            past_stats: LinkStats::default(),
         };
         robot.hello = robot.handshake()?;
         Ok(robot)
@@ -372,31 +380,11 @@ impl<D: Driver> Robot<D> {
         self.driver.subscribe()
     }
 
-    /// Link counters (frames, rejects, heartbeats, retries).
+    /// Link counters (frames, rejects, heartbeats, retries), over every session so far.
     pub fn stats(&self) -> LinkStats {
-        self.driver.inspect(|c| c.stats())
-    }
-
-    /// Close the link and open it again (retrying for [`LinkOptions::reconnect_timeout`]),
-    /// then shake hands anew, which clears a latched `LINK_LOST`.
-    pub fn reconnect(&mut self) -> Result<(), LinkError> {
-        let deadline = Instant::now() + self.opts.reconnect_timeout;
-        loop {
-            let attempt = self.driver.reopen().and_then(|()| self.handshake());
-            match attempt {
-                Ok(h) => {
-                    self.hello = h;
-                    return Ok(());
-                }
-                Err(e @ LinkError::VersionMismatch { .. }) => return Err(e),
-                Err(e) if Instant::now() >= deadline => return Err(e),
-                Err(e) => {
-                    tracing::debug!("reconnect to {}: {e}; retrying", self.path());
-                    // Waiting for a device to reappear is wall-clock business.
-                    std::thread::sleep(Duration::from_millis(100));
-                }
-            }
-        }
+        let mut s = self.past_stats;
+        s += self.driver.inspect(|c| c.stats());
+        s
     }
 
     /// Test hook: stop (`true`) or resume heartbeats, as if the host went quiet. The robot's

@@ -24,7 +24,8 @@ pub struct LinkOptions {
     /// The robot's link watchdog the heartbeats are paced for, ms of robot time (the firmware
     /// default is 200; [`super::Robot::configure`] keeps this up to date).
     pub watchdog_ms: u16,
-    /// How long [`super::Robot::reconnect`] keeps trying, wall time.
+    /// How long [`super::Robot::reconnect`] keeps trying while the port is away or mute, wall
+    /// time (`--reconnect SECONDS`); zero: one attempt (a vanished port is then an error at once).
     pub reconnect_timeout: Duration,
     /// Offer this protocol version in the handshake instead of [`PROTOCOL_VERSION`]: a test and
     /// diagnostic hook to check that a mismatch is refused.
@@ -39,7 +40,7 @@ impl Default for LinkOptions {
             hello_timeout: Duration::from_secs(2),
             dead_link_timeout: Duration::from_secs(3),
             watchdog_ms: 200,
-            reconnect_timeout: Duration::from_secs(5),
+            reconnect_timeout: Duration::ZERO,
             protocol_version_override: None,
         }
     }

@@ -205,9 +205,17 @@ impl Driver for InProcess {
         self.lock().subscribers.subscribe()
     }
 
+    /// A fresh client on the same simulator and wire (as a serial port closed and opened
+    /// again): the sequence numbers go on, bytes already on the wire stay there.
     fn reopen(&mut self) -> Result<(), LinkError> {
-        Err(LinkError::InvalidArgument(
-            "the in-process simulator cannot be reconnected".into(),
-        ))
+        let mut inner = self.lock();
+        let now = inner.now();
+        let opts = ClientOptions {
+            watchdog_ms: inner.client.watchdog_ms(),
+            first_seq: inner.client.next_seq(),
+            ..inner.client.options().clone()
+        };
+        inner.client = Client::new(now, opts);
+        Ok(())
     }
 }

@@ -8,6 +8,8 @@ use pushbot_sim::camera::live::LiveCameraOptions;
 use pushbot_sim::{PtySim, SimOptions};
 use pushbot_world::Scene;
 
+pub use pushbot_sim::faults::{FaultArgs, LinkFaults};
+
 /// A simulated robot and camera serving one scene.
 pub struct SimTarget {
     sim: PtySim,
@@ -25,16 +27,19 @@ impl std::fmt::Debug for SimTarget {
 
 impl SimTarget {
     /// Serve `scene` with every random draw from `seed`, simulated time running `speed` times
-    /// faster than the wall clock; camera frames are also written to `frames_dir` if given.
+    /// faster than the wall clock; camera frames are also written to `frames_dir` if given, and
+    /// `faults` (if any) are injected on the serial link, both ways.
     pub fn start(
         scene: &Scene,
         seed: u64,
         speed: f64,
         frames_dir: Option<std::path::PathBuf>,
+        faults: Option<LinkFaults>,
     ) -> Result<SimTarget> {
         let sim = PtySim::start(SimOptions {
             seed,
             speed,
+            faults,
             scene: Some(scene.clone()),
             camera: Some(LiveCameraOptions {
                 frames_dir,

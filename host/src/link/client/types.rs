@@ -167,6 +167,18 @@ pub struct LinkStats {
     pub retries: u64,
 }
 
+impl std::ops::AddAssign for LinkStats {
+    /// Counters of two sessions of one link, summed.
+    fn add_assign(&mut self, o: LinkStats) {
+        self.bytes_received += o.bytes_received;
+        self.frames_ok += o.frames_ok;
+        self.frames_rejected += o.frames_rejected;
+        self.frames_sent += o.frames_sent;
+        self.heartbeats_sent += o.heartbeats_sent;
+        self.retries += o.retries;
+    }
+}
+
 /// How a command was answered.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Answer {

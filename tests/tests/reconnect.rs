@@ -1,0 +1,98 @@
+//! A port that disappears and comes back (issue 19, item 5), over a real pty: the simulator keeps
+//! a stable link path to its pty (as udev keeps `/dev/serial/by-id/…`), drops the pty and serves
+//! a new one behind the same path. With a reconnect time the host waits for it, opens a new
+//! session and goes on; without one it fails at once with an error that says what to do.
+
+use std::time::Duration;
+
+use pushbot::link::LinkError;
+use pushbot::robot::{LinkOptions, Robot};
+use pushbot_protocol::{Command, Faults, Outcome};
+use pushbot_sim::{PtySim, SimOptions};
+use pushbot_tests::SIM_SPEED;
+
+fn linked_sim(seed: u64, link: &std::path::Path) -> PtySim {
+    PtySim::start(SimOptions {
+        seed,
+        speed: SIM_SPEED,
+        link: Some(link.to_path_buf()),
+        ..SimOptions::default()
+    })
+    .expect("start the simulated robot")
+}
+
+fn connect(path: &std::path::Path, reconnect: Duration) -> Robot {
+    let opts = LinkOptions {
+        reconnect_timeout: reconnect,
+        ..LinkOptions::default()
+    };
+    let robot = Robot::connect(path.to_str().expect("utf-8"), opts).expect("connect");
+    // 1 s of robot time (200 ms of wall time at 5×): a loaded test machine does not trip it.
+    robot
+        .configure(pushbot_protocol::ConfigUpdate {
+            watchdog_ms: Some(1000),
+            ..Default::default()
+        })
+        .expect("configure");
+    robot
+}
+
+/// Start a long move, unplug the port for `gap` of robot time, and return the move's end.
+fn unplug_during_a_move(sim: &PtySim, robot: &Robot, gap: Duration) -> (u16, LinkError) {
+    let m = robot
+        .start(Command::Move {
+            distance: 0.3,
+            speed: 0.1,
+            stop_on_contact: false,
+        })
+        .expect("move accepted");
+    std::thread::sleep(Duration::from_millis(100));
+    sim.unplug(gap).expect("unplug");
+    let err = robot
+        .wait(&m)
+        .expect_err("the port went away under the move");
+    (m.seq, err)
+}
+
+#[test]
+fn with_reconnect_the_host_waits_for_the_port_and_goes_on() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let link = dir.path().join("ttyPUSHBOT");
+    let sim = linked_sim(31, &link);
+    let mut robot = connect(&link, Duration::from_secs(20));
+    let (seq, err) = unplug_during_a_move(&sim, &robot, Duration::from_secs(3));
+    assert!(pushbot::robot::link_broke(&err), "{err}");
+    let rec = robot
+        .recover(&err.to_string(), Some((seq, "Move")))
+        .expect("the port came back");
+    assert!(rec.reopen_attempts > 1, "it had to wait: {rec:?}");
+    let out = rec.interrupted.expect("interrupted").outcome;
+    assert_eq!(
+        out.as_deref(),
+        Some("fault (LINK_LOST)"),
+        "the watchdog ended it"
+    );
+    assert_eq!(sim.unplugs(), (1, 1));
+    let done = robot.move_distance(-0.1, 0.1, false).expect("moves again");
+    assert_eq!(done.outcome, Outcome::Completed);
+    let t = robot.wait_telemetry(None).expect("telemetry");
+    assert_eq!(t.faults, Faults::NONE);
+    assert_eq!(robot.recoveries().len(), 1);
+}
+
+#[test]
+fn without_reconnect_a_vanished_port_is_a_clear_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let link = dir.path().join("ttyPUSHBOT");
+    let sim = linked_sim(32, &link);
+    let mut robot = connect(&link, Duration::ZERO);
+    let (seq, err) = unplug_during_a_move(&sim, &robot, Duration::from_secs(30));
+    let failed = robot
+        .recover(&err.to_string(), Some((seq, "Move")))
+        .expect_err("the port is away");
+    assert!(matches!(failed, LinkError::Vanished { .. }), "{failed}");
+    let msg = failed.to_string();
+    assert!(msg.contains("--reconnect SECONDS"), "{msg}");
+    assert!(msg.contains("ttyPUSHBOT"), "{msg}");
+    assert!(robot.recoveries().is_empty());
+}
