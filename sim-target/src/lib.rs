@@ -23,6 +23,7 @@ pub mod pushing;
 pub mod quasistatic;
 pub mod robot;
 pub mod sim;
+pub mod terminal;
 pub mod truth;
 pub mod world;
 

@@ -14,7 +14,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 
-use crate::pty::Pty;
+use crate::terminal::Pty;
 
 /// One unplug: at `at_us` of simulated time the port goes away for `for_us`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
