@@ -36,16 +36,7 @@ fn a_thousand_commands_survive_a_noisy_wire() {
     }
 }
 
-const CLEAN: LinkFaults = LinkFaults {
-    drop: 0.0,
-    corrupt: 0.0,
-    garbage: 0.0,
-    frame_loss: 0.0,
-    duplicate: 0.0,
-    max_delay_us: 0,
-    cut_every_us: 0,
-    cut_for_us: 0,
-};
+const CLEAN: LinkFaults = LinkFaults::NONE;
 
 #[test]
 fn real_cuts_stop_the_motors_within_250_ms() {

@@ -12,16 +12,7 @@ use pushbot_protocol::{Command, Faults, Outcome};
 use pushbot_sim::faults::LinkFaults;
 use pushbot_sim::{Pose, Sim, SimOptions};
 
-const CLEAN: LinkFaults = LinkFaults {
-    drop: 0.0,
-    corrupt: 0.0,
-    garbage: 0.0,
-    frame_loss: 0.0,
-    duplicate: 0.0,
-    max_delay_us: 0,
-    cut_every_us: 0,
-    cut_for_us: 0,
-};
+const CLEAN: LinkFaults = LinkFaults::NONE;
 
 fn robot(seed: u64) -> Robot<InProcess> {
     let sim = Sim::new(&SimOptions {

@@ -61,6 +61,18 @@ impl Default for LinkFaults {
 }
 
 impl LinkFaults {
+    /// A clean wire: no fault at all (what a pipe is before its faults are switched on).
+    pub const NONE: LinkFaults = LinkFaults {
+        drop: 0.0,
+        corrupt: 0.0,
+        garbage: 0.0,
+        frame_loss: 0.0,
+        duplicate: 0.0,
+        max_delay_us: 0,
+        cut_every_us: 0,
+        cut_for_us: 0,
+    };
+
     /// Whether the link is cut at `now_us`.
     pub fn cut(&self, now_us: u64) -> bool {
         self.cut_every_us > 0
@@ -247,16 +259,7 @@ impl FaultPipe {
 mod tests {
     use super::*;
 
-    const NONE: LinkFaults = LinkFaults {
-        drop: 0.0,
-        corrupt: 0.0,
-        garbage: 0.0,
-        frame_loss: 0.0,
-        duplicate: 0.0,
-        max_delay_us: 0,
-        cut_every_us: 0,
-        cut_for_us: 0,
-    };
+    const NONE: LinkFaults = LinkFaults::NONE;
 
     /// 1000 frames of 9 bytes: bytes 1..=8 then the delimiter.
     fn frames() -> Vec<u8> {

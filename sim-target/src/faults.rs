@@ -125,16 +125,7 @@ mod tests {
     /// is lost; during a cut everything is; delays keep order and hold bytes back.
     #[test]
     fn faults_behave_as_configured() {
-        let none = LinkFaults {
-            drop: 0.0,
-            corrupt: 0.0,
-            garbage: 0.0,
-            frame_loss: 0.0,
-            duplicate: 0.0,
-            max_delay_us: 0,
-            cut_every_us: 0,
-            cut_for_us: 0,
-        };
+        let none = LinkFaults::NONE;
         let data: Vec<u8> = (0..=255).collect();
         let mut l = FaultyLink::new(none, 1);
         l.from_host(0, &data);
