@@ -105,6 +105,56 @@ fn retry_with_same_seq_executes_once() {
     assert!((d.pose.x - 0.1).abs() < 0.003, "moved once: {:?}", d.pose);
 }
 
+/// A new session (a restarted host's `Hello`) replaces the retry cache: a command of the new
+/// session that happens to repeat the old session's last number and command is a new command,
+/// executed — and within a session the same frame is a retry, executed once.
+#[test]
+fn a_new_session_is_never_answered_from_the_old_sessions_cache() {
+    let mut b = Bench::connected();
+    let frame = HostFrame {
+        seq: 500,
+        cmd: Command::Move {
+            distance: 0.05,
+            speed: 0.2,
+            stop_on_contact: false,
+        },
+    };
+    b.send_frame(frame);
+    assert_eq!(
+        b.run_until_done(500, 3_000).expect("done").outcome,
+        Outcome::Completed
+    );
+    let after_first = b.travel();
+    // The host restarts: a new Hello (numbered 499), then the same number and command again.
+    b.send_frame(HostFrame {
+        seq: 499,
+        cmd: Command::Hello {
+            protocol: PROTOCOL_VERSION,
+        },
+    });
+    b.run_ms(5);
+    b.send_frame(frame);
+    b.run_ms(100);
+    assert!(
+        b.travel() > after_first + 1e-3,
+        "the new session's command runs"
+    );
+    b.run_ms(1_000);
+    assert_eq!(b.dones(500), 2, "two commands, two ends");
+    assert!(
+        (b.travel() - 2.0 * after_first).abs() < 0.006,
+        "driven twice, once per session: {} then {}",
+        after_first,
+        b.travel()
+    );
+    // Within the session, the same frame again is a retry: answered, not driven.
+    let before = b.travel();
+    b.send_frame(frame);
+    b.run_ms(500);
+    assert_eq!(b.dones(500), 2, "no third end");
+    assert!((b.travel() - before).abs() < 1e-4, "not driven again");
+}
+
 #[test]
 fn version_mismatch_is_refused() {
     let mut b = Bench::new();

@@ -96,3 +96,60 @@ fn without_reconnect_a_vanished_port_is_a_clear_error() {
     assert!(msg.contains("ttyPUSHBOT"), "{msg}");
     assert!(robot.recoveries().is_empty());
 }
+
+/// The same through the command line: `pushbot robot move --reconnect 20` rides out the unplug
+/// and completes the move (the rest sent anew); without `--reconnect` it fails and says why.
+#[test]
+fn the_cli_move_waits_for_the_port_with_reconnect_and_fails_clearly_without() {
+    use clap::Parser;
+    use pushbot::cli::{Cli, CliError, Status, run};
+    for (seed, reconnect) in [(33, Some("20")), (34, None)] {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let link = dir.path().join("ttyPUSHBOT");
+        let sim = linked_sim(seed, &link);
+        let start = sim.truth().pose;
+        let port = link.to_str().expect("utf-8").to_string();
+        let mut argv = vec!["pushbot", "--json"];
+        if let Some(s) = reconnect {
+            argv.extend(["--reconnect", s]);
+        }
+        argv.extend([
+            "robot",
+            "move",
+            "--distance",
+            "0.3",
+            "--speed",
+            "0.1",
+            "--port",
+            &port,
+        ]);
+        let cli = Cli::try_parse_from(&argv).expect("arguments parse");
+        let result = std::thread::scope(|s| {
+            // 3 s of robot time into the move (0.6 s of wall time), the port goes for 2 s.
+            s.spawn(|| {
+                pushbot_tests::wait_truth(&sim, Duration::from_secs(30), |t| {
+                    t.duty.iter().any(|&u| u != 0.0)
+                })
+                .expect("the move starts");
+                std::thread::sleep(Duration::from_millis(200));
+                sim.unplug(Duration::from_secs(2)).expect("unplug");
+            });
+            run(cli)
+        });
+        assert_eq!(sim.unplugs().0, 1, "unplugged once");
+        match reconnect {
+            Some(_) => {
+                assert!(matches!(result, Ok(Status::Success)), "{result:?}");
+                let moved = pushbot_tests::dist(&sim.truth().pose, &start);
+                assert!((moved - 0.3).abs() < 0.01, "moved {moved} m, not 0.3");
+            }
+            None => match result {
+                Err(CliError::Failed(e)) => {
+                    let msg = format!("{e:#}");
+                    assert!(msg.contains("--reconnect"), "{msg}");
+                }
+                other => panic!("without --reconnect: {other:?}"),
+            },
+        }
+    }
+}
