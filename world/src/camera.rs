@@ -1,5 +1,5 @@
 //! The camera as the world sees it: the table-plane → pixel map of an overhead camera
-//! ([`CameraModel`], a homography for now; the real-camera issue adds the lens and the pose),
+//! ([`CameraModel`], a homography; a real lens and the camera's pose are [`crate::lens`]),
 //! the AprilTag markers placed on the table ([`MarkerPlacement`]) and what a frame source
 //! reports of each frame ([`FrameHeader`], [`MarkerTruth`]). Pixel centres are at `i + 0.5`.
 

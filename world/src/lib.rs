@@ -7,6 +7,8 @@
 //! * [`scene`] — the one scene format (TOML), its validation with file:line:col errors, and
 //!   [`presets`];
 //! * [`camera`] — the camera model and the markers it sees;
+//! * [`lens`] — a real camera's intrinsics, `plumb_bob` distortion and pose over the table, and
+//!   [`lens_file`] — the ROS and OpenCV intrinsics files, read and written;
 //! * [`workspace`] — the table and the boundary of a delivery (Lau et al. §III-A).
 //!
 //! The table frame has its origin at the table's lower-left corner, x along the width, y along
@@ -18,6 +20,8 @@
 pub mod body;
 pub mod camera;
 pub mod geometry;
+pub mod lens;
+pub mod lens_file;
 pub mod polygon;
 pub mod pose;
 pub mod presets;
