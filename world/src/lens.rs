@@ -178,7 +178,8 @@ impl Intrinsics {
 
     /// The pixel of a point in the camera frame (z forward, x right, y down), if in front.
     pub fn project(&self, p: [f64; 3]) -> Option<[f64; 2]> {
-        if !(p[2] > 1e-9) {
+        // In front of the camera (a NaN depth is not).
+        if p[2].is_nan() || p[2] <= 1e-9 {
             return None;
         }
         let d = self.distortion.apply([p[0] / p[2], p[1] / p[2]]);
