@@ -8,6 +8,7 @@
 //! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
 
 pub mod families;
+pub mod lens;
 pub mod live;
 pub mod render;
 pub mod scene_view;
@@ -77,6 +78,9 @@ pub struct CameraConfig {
     pub fps: f64,
     /// Table size (metres), drawn as a rectangle from (0, 0).
     pub table: [f64; 2],
+    /// A real lens: the image is drawn through `model` (the ideal pinhole) and then distorted
+    /// by these intrinsics, made for the same image size ([`lens::LensWarp`]).
+    pub lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
 impl CameraConfig {
@@ -87,6 +91,7 @@ impl CameraConfig {
             imaging: Imaging::default(),
             fps: 30.0,
             table,
+            lens: None,
         }
     }
 }
@@ -148,6 +153,8 @@ pub struct Camera {
     /// The last scene drawn and its blurred irradiance: a frame of a scene that has not moved
     /// (the robot waiting for its host) differs from it only by the sensor's fresh noise.
     still: Option<Still>,
+    /// The lens's warp, when the configuration has a lens.
+    warp: Option<lens::LensWarp>,
 }
 
 /// A drawn scene: what was drawn, the blurred irradiance, the markers' ground truth.
@@ -199,7 +206,15 @@ impl Camera {
                 "frame rate and image size must be positive".into(),
             ));
         }
+        let warp = match config.lens {
+            Some(l) => Some(
+                lens::LensWarp::new(l, config.model.width, config.model.height)
+                    .map_err(CameraError::Invalid)?,
+            ),
+            None => None,
+        };
         Ok(Camera {
+            warp,
             config,
             codes: TagCodes::new().map_err(CameraError::Invalid)?,
             rng: ChaCha8Rng::seed_from_u64(seed),
@@ -284,7 +299,13 @@ impl Camera {
             canvas
                 .marker(&self.codes, m, im.quiet_cells, n, im.ink[0], im.ink[1])
                 .map_err(CameraError::Invalid)?;
-            let px = |p: [f64; 2]| h_tp.apply(p).unwrap_or([f64::NAN; 2]);
+            let px = |p: [f64; 2]| {
+                let ideal = h_tp.apply(p).unwrap_or([f64::NAN; 2]);
+                match &self.warp {
+                    Some(w) => w.distort_pixel(ideal),
+                    None => ideal,
+                }
+            };
             let (_, tw, wab) = self
                 .codes
                 .pattern(m.family, m.id)
@@ -306,10 +327,14 @@ impl Camera {
             });
         }
         render::gaussian_blur(&mut canvas.data, w, h, im.blur_sigma_px);
+        let irradiance = match &self.warp {
+            Some(warp) => warp.apply(&canvas.data, w, h, im.floor_shade as f32),
+            None => canvas.data,
+        };
         Ok(Still {
             polygons: polygons.to_vec(),
             markers: markers.to_vec(),
-            irradiance: canvas.data,
+            irradiance,
             truth,
         })
     }

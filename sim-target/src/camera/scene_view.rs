@@ -84,6 +84,8 @@ pub fn scene_camera_config(scene: &Scene, imaging: Imaging) -> CameraConfig {
         imaging,
         fps: scene.camera.fps,
         table,
+        // The scene's `camera.intrinsics` file is not read yet (issue 20): an ideal pinhole.
+        lens: None,
     }
 }
 

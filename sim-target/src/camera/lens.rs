@@ -1,0 +1,127 @@
+//! The camera's lens in the rendered image: the scene is drawn through the ideal pinhole (the
+//! table→pixel homography), then warped through the lens's `plumb_bob` distortion
+//! ([`pushbot_world::lens`]) — each output pixel takes the ideal image's irradiance where its
+//! undistorted ray falls (bilinear), from a map computed once per camera, as OpenCV's
+//! `initUndistortRectifyMap` + `remap` do the other way round. Marker corners in the ground
+//! truth go through the same distortion.
+
+use pushbot_world::lens::Intrinsics;
+
+/// Where each output pixel samples the ideal image (its index-space x, y; NaN: nowhere).
+#[derive(Debug, Clone)]
+pub struct LensWarp {
+    lens: Intrinsics,
+    map: Vec<[f32; 2]>,
+}
+
+impl LensWarp {
+    /// The warp of a `width`×`height` image through `lens`, which must be made for that size.
+    pub fn new(lens: Intrinsics, width: u32, height: u32) -> Result<LensWarp, String> {
+        if (lens.width, lens.height) != (width, height) {
+            return Err(format!(
+                "the lens is calibrated for {}×{} frames, the camera renders {width}×{height}",
+                lens.width, lens.height
+            ));
+        }
+        if let Some(p) = lens.problem() {
+            return Err(format!("lens: {p}"));
+        }
+        let mut map = Vec::with_capacity(width as usize * height as usize);
+        for j in 0..height {
+            for i in 0..width {
+                let px = [f64::from(i) + 0.5, f64::from(j) + 0.5];
+                map.push(match lens.undistort_pixel(px) {
+                    Some([u, v]) => [(u - 0.5) as f32, (v - 0.5) as f32],
+                    None => [f32::NAN; 2],
+                });
+            }
+        }
+        Ok(LensWarp { lens, map })
+    }
+
+    /// Where an ideal pixel (the homography's) appears in the distorted image.
+    pub fn distort_pixel(&self, ideal: [f64; 2]) -> [f64; 2] {
+        let l = &self.lens;
+        let d = l
+            .distortion
+            .apply([(ideal[0] - l.cx) / l.fx, (ideal[1] - l.cy) / l.fy]);
+        [l.fx * d[0] + l.cx, l.fy * d[1] + l.cy]
+    }
+
+    /// The distorted image of an ideal one (`background` where the lens sees past it).
+    pub fn apply(&self, ideal: &[f32], width: usize, height: usize, background: f32) -> Vec<f32> {
+        let at = |x: usize, y: usize| ideal.get(y * width + x).copied().unwrap_or(background);
+        self.map
+            .iter()
+            .map(|&[u, v]| {
+                if !(u.is_finite() && v.is_finite())
+                    || u < 0.0
+                    || v < 0.0
+                    || u > (width - 1) as f32
+                    || v > (height - 1) as f32
+                {
+                    return background;
+                }
+                let (x0, y0) = (u.floor() as usize, v.floor() as usize);
+                let (x1, y1) = ((x0 + 1).min(width - 1), (y0 + 1).min(height - 1));
+                let (fx, fy) = (u - x0 as f32, v - y0 as f32);
+                let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+                let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
+                top * (1.0 - fy) + bottom * fy
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pushbot_world::lens::Distortion;
+
+    fn lens(k1: f64) -> Intrinsics {
+        Intrinsics {
+            width: 64,
+            height: 48,
+            fx: 50.0,
+            fy: 50.0,
+            cx: 32.0,
+            cy: 24.0,
+            distortion: Distortion {
+                k1,
+                ..Distortion::NONE
+            },
+        }
+    }
+
+    #[test]
+    fn a_bright_spot_moves_where_the_lens_puts_it() {
+        let (w, h) = (64usize, 48usize);
+        let warp = LensWarp::new(lens(-0.3), 64, 48).unwrap();
+        // A 2×2 bright square in the ideal image near a corner.
+        let mut ideal = vec![0.0f32; w * h];
+        for (x, y) in [(8, 6), (9, 6), (8, 7), (9, 7)] {
+            ideal[y * w + x] = 1.0;
+        }
+        let out = warp.apply(&ideal, w, h, 0.0);
+        let (mut sx, mut sy, mut s) = (0.0, 0.0, 0.0);
+        for (k, v) in out.iter().enumerate() {
+            sx += f64::from(*v) * ((k % w) as f64 + 0.5);
+            sy += f64::from(*v) * ((k / w) as f64 + 0.5);
+            s += f64::from(*v);
+        }
+        let seen = [sx / s, sy / s];
+        let want = warp.distort_pixel([9.0, 7.0]);
+        assert!(
+            (seen[0] - want[0]).hypot(seen[1] - want[1]) < 0.35,
+            "spot at {seen:?}, the lens puts it at {want:?}"
+        );
+        // Barrel: pulled towards the centre.
+        assert!(want[0] > 9.0 && want[1] > 7.0, "{want:?}");
+    }
+
+    #[test]
+    fn a_lens_for_other_frames_is_refused() {
+        let e = LensWarp::new(lens(-0.1), 960, 720).unwrap_err();
+        assert!(e.contains("64×48"), "{e}");
+    }
+}
