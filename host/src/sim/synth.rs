@@ -35,6 +35,8 @@ pub struct SynthParams {
     pub noise: [f64; 2],
     /// Exposure range.
     pub exposure: [f64; 2],
+    /// A real lens the frames are seen through (its image size must be `size`).
+    pub lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
 impl Default for SynthParams {
@@ -45,6 +47,7 @@ impl Default for SynthParams {
             blur: [0.5, 1.0],
             noise: [2.0, 4.0],
             exposure: [0.85, 1.1],
+            lens: None,
         }
     }
 }
@@ -157,6 +160,7 @@ fn render(
         .tilted(params.tilt[0], params.tilt[1]);
     let mut config = CameraConfig::default_for_table(layout.table);
     config.model = model;
+    config.lens = params.lens;
     let mut camera = Camera::new(config, seed ^ 0x5eed).map_err(|e| e.to_string())?;
     let [tw, th] = layout.table;
     let nb = layout.bodies.len().max(1);

@@ -35,6 +35,7 @@ pub mod layout;
 pub mod simsocket;
 pub mod source;
 pub mod tracking;
+pub mod undistort;
 pub mod v4l2;
 
 use serde::Serialize;
@@ -166,6 +167,8 @@ pub struct Pipeline {
     since_full: u32,
     /// Bodies seen in the last frame, by name.
     sightings: Vec<(String, Sighting)>,
+    /// The camera's lens: detections are undistorted before they are measured.
+    lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
 impl std::fmt::Debug for Pipeline {
@@ -197,6 +200,27 @@ impl Pipeline {
             roi: RoiParams::default(),
             since_full: 0,
             sightings: Vec::new(),
+            lens: None,
+        }
+    }
+
+    /// The same pipeline for a camera with this lens: detected corners are undistorted before
+    /// they are measured (the calibration must have been fit on undistorted corners too,
+    /// [`undistort::undistort_detections`]).
+    pub fn with_lens(mut self, lens: pushbot_world::lens::Intrinsics) -> Pipeline {
+        self.lens = Some(lens);
+        self
+    }
+
+    /// Measure detections (raw pixels) through the lens, if there is one.
+    fn measure_raw(&self, dets: &[Detection]) -> Vec<Measurement> {
+        match &self.lens {
+            Some(lens) => measure(
+                &undistort::undistort_detections(dets, lens),
+                &self.calibration,
+                &self.layout,
+            ),
+            None => measure(dets, &self.calibration, &self.layout),
         }
     }
 
@@ -263,7 +287,7 @@ impl Pipeline {
                     }
                 }
             }
-            let ms = measure(&dets, &self.calibration, &self.layout);
+            let ms = self.measure_raw(&dets);
             if self
                 .sightings
                 .iter()
@@ -274,7 +298,7 @@ impl Pipeline {
             }
         }
         let dets = self.detector.detect(frame)?;
-        let ms = measure(&dets, &self.calibration, &self.layout);
+        let ms = self.measure_raw(&dets);
         self.since_full = 0;
         Ok((dets, ms, true))
     }
