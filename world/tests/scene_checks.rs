@@ -372,3 +372,67 @@ fn a_clockwise_stable_object_keeps_its_pushing_edge() {
         "{notes:?}"
     );
 }
+
+/// The scene's `camera.intrinsics` is read relative to the scene file into `camera.lens`; a
+/// missing file, a broken one or one for another image size is refused at the key's line.
+#[test]
+fn the_lens_file_is_read_with_the_scene_and_checked() {
+    use pushbot_world::lens::{Distortion, Intrinsics};
+    use pushbot_world::lens_file::{LensFormat, write_intrinsics};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lens = Intrinsics {
+        width: 960,
+        height: 720,
+        fx: 700.0,
+        fy: 700.0,
+        cx: 480.0,
+        cy: 360.0,
+        distortion: Distortion {
+            k1: -0.08,
+            ..Distortion::NONE
+        },
+    };
+    std::fs::create_dir_all(dir.path().join("cams")).unwrap();
+    std::fs::write(
+        dir.path().join("cams/webcam.yaml"),
+        write_intrinsics(&lens, LensFormat::OpenCv, "webcam"),
+    )
+    .unwrap();
+    let scene_with = |intrinsics: &str| {
+        let text = format!("{BASE}\n[camera]\nintrinsics = \"{intrinsics}\"\n");
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, &text).unwrap();
+        (Scene::load(&path), text)
+    };
+    let (ok, _) = scene_with("cams/webcam.yaml");
+    assert_eq!(ok.expect("loads").camera.lens, Some(lens));
+    let (missing, text) = scene_with("cams/none.yaml");
+    let e = missing.expect_err("refused").to_string();
+    let line = line_of(&text, "intrinsics =");
+    assert!(e.contains(&format!("scene.toml:{line}:")), "{e}");
+    assert!(
+        e.contains("camera.intrinsics") && e.contains("none.yaml"),
+        "{e}"
+    );
+    std::fs::write(
+        dir.path().join("cams/small.yaml"),
+        write_intrinsics(
+            &Intrinsics {
+                width: 640,
+                height: 480,
+                cx: 320.0,
+                cy: 240.0,
+                ..lens
+            },
+            LensFormat::Ros,
+            "small",
+        ),
+    )
+    .unwrap();
+    let (small, _) = scene_with("cams/small.yaml");
+    let e = small.expect_err("refused").to_string();
+    assert!(e.contains("640×480") && e.contains("960×720"), "{e}");
+    std::fs::write(dir.path().join("cams/bad.yaml"), "camera_matrix: [\n").unwrap();
+    let (bad, _) = scene_with("cams/bad.yaml");
+    assert!(bad.is_err());
+}

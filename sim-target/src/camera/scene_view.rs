@@ -84,8 +84,8 @@ pub fn scene_camera_config(scene: &Scene, imaging: Imaging) -> CameraConfig {
         imaging,
         fps: scene.camera.fps,
         table,
-        // The scene's `camera.intrinsics` file is not read yet (issue 20): an ideal pinhole.
-        lens: None,
+        // The lens of the scene's `camera.intrinsics` file, if it has one (read with the scene).
+        lens: scene.camera.lens,
     }
 }
 

@@ -11,7 +11,7 @@
 //! # calibration markers at known table positions (table frame); default: six 5 cm tags,
 //! # ids 40–45, 6 cm in from the four corners and the middles of the long edges
 //! fiducials = [{ id = 40, x = 0.06, y = 0.06, size = 0.05 }]
-//! intrinsics = "camera.yaml"  # lens model file (camera_info or OpenCV YAML); not read yet
+//! intrinsics = "camera.yaml"  # lens model (ROS camera_info or OpenCV YAML), relative to the scene file
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -37,9 +37,13 @@ pub struct CameraSpec {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fiducials: Option<Vec<Marker>>,
     /// A file with the lens model (ROS `camera_info` YAML or OpenCV YAML), path relative to
-    /// the working directory; not read yet: filled in by the real-camera work.
+    /// the scene file; read into [`CameraSpec::lens`] when the scene is loaded from a file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intrinsics: Option<String>,
+    /// The lens read from `intrinsics` ([`crate::lens_file`]), checked against `width` ×
+    /// `height`; `None`: an ideal pinhole.
+    #[serde(skip)]
+    pub lens: Option<crate::lens::Intrinsics>,
 }
 
 impl Default for CameraSpec {
@@ -57,6 +61,7 @@ impl Default for CameraSpec {
             },
             fiducials: None,
             intrinsics: None,
+            lens: None,
         }
     }
 }

@@ -53,7 +53,7 @@ mod sections;
 mod validate;
 pub use camera::CameraSpec;
 pub use error::SceneError;
-use error::{key_before, line_col, path_string, span_of};
+use error::{Seg, key_before, line_col, path_string, span_of};
 pub mod rearrange;
 pub mod stable;
 
@@ -336,7 +336,34 @@ impl Scene {
                 format!("cannot read: {e}")
             },
         })?;
-        Scene::from_toml_noted(&text, &file)
+        let (mut scene, notes) = Scene::from_toml_noted(&text, &file)?;
+        if let Some(name) = scene.camera.intrinsics.clone() {
+            let at = |message: String| {
+                let span = span_of(&text, &[Seg::Key("camera"), Seg::Key("intrinsics")]);
+                let (line, column) = span.map_or((None, None), |s| {
+                    let (l, c) = line_col(&text, s.start);
+                    (Some(l), Some(c))
+                });
+                SceneError {
+                    file: file.clone(),
+                    line,
+                    column,
+                    field: Some("camera.intrinsics".into()),
+                    message,
+                }
+            };
+            let lens_path = path.parent().unwrap_or(Path::new(".")).join(&name);
+            let lens =
+                crate::lens_file::read_intrinsics(&lens_path).map_err(|e| at(e.to_string()))?;
+            if (lens.width, lens.height) != (scene.camera.width, scene.camera.height) {
+                return Err(at(format!(
+                    "the lens file is for {}×{} frames, the scene's camera is {}×{}",
+                    lens.width, lens.height, scene.camera.width, scene.camera.height
+                )));
+            }
+            scene.camera.lens = Some(lens);
+        }
+        Ok((scene, notes))
     }
 
     /// A built-in preset by name (see [`PRESETS`]).
