@@ -359,3 +359,29 @@ fn binaries_are_found() {
         assert!(Path::new(&p).is_file(), "{}", p.display());
     }
 }
+
+// ---- lens files ----------------------------------------------------------------------------
+
+/// `--intrinsics` that is missing, not YAML of either format, or not a plumb_bob lens: exit 2,
+/// naming the file and what is wrong, before anything runs.
+#[test]
+fn intrinsics_files_that_do_not_make_a_lens() {
+    let f = Files::new();
+    let broken = f.write("broken.yaml", "camera_matrix: [\n");
+    let fisheye = f.write(
+        "fisheye.yaml",
+        "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  \
+         data: [600, 0, 320, 0, 600, 240, 0, 0, 1]\ndistortion_model: equidistant\n\
+         distortion_coefficients:\n  rows: 1\n  cols: 4\n  data: [0.1, 0, 0, 0]\n",
+    );
+    let missing = f.path("missing.yaml");
+    let missing = missing.to_str().expect("UTF-8").to_owned();
+    for (file, needle) in [
+        (broken.as_str(), "not a ROS camera_info or OpenCV"),
+        (fisheye.as_str(), "only plumb_bob"),
+        (missing.as_str(), "No such file"),
+    ] {
+        let r = pushbot(&["--intrinsics", file, "demo", "--stages", "stable"]);
+        assert_bad_input(&r, &[file, needle]);
+    }
+}

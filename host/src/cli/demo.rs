@@ -170,6 +170,7 @@ fn run_stages(
         faults,
         link: g.link_options()?,
         recover: !g.no_recover,
+        lens: g.lens()?,
     };
     let t0 = Instant::now();
     if args.view && !g.json {

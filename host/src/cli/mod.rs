@@ -42,9 +42,24 @@ pub struct Global {
     /// instead of reconnecting, clearing the link's fault and going on from the measured pose.
     #[arg(long, global = true)]
     pub no_recover: bool,
+    /// The camera's lens: a ROS `camera_info` or OpenCV `FileStorage` YAML file (intrinsics and
+    /// `plumb_bob` distortion), for commands that use a camera; overrides the scene's
+    /// `camera.intrinsics`.
+    #[arg(long, global = true, value_name = "FILE")]
+    pub intrinsics: Option<std::path::PathBuf>,
 }
 
 impl Global {
+    /// The lens `--intrinsics` names, read and checked.
+    pub fn lens(&self) -> Result<Option<pushbot_world::lens::Intrinsics>, CliError> {
+        match &self.intrinsics {
+            Some(p) => pushbot_world::lens_file::read_intrinsics(p)
+                .map(Some)
+                .map_err(|e| CliError::bad_input(format!("--intrinsics: {e}"))),
+            None => Ok(None),
+        }
+    }
+
     /// The serial link's settings these flags ask for.
     pub fn link_options(&self) -> Result<crate::robot::LinkOptions, CliError> {
         let mut o = crate::robot::LinkOptions::default();

@@ -88,6 +88,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
         watchdog_ms: a.watchdog_ms,
         link: global.link_options()?,
         recover: !global.no_recover,
+        lens: global.lens()?,
         ..LiveOptions::default()
     };
     let mut io = LiveRobot::connect(port, camera, scene, opts).map_err(CliError::Failed)?;

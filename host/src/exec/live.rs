@@ -65,6 +65,9 @@ pub struct LiveOptions {
     /// Recover from a broken link ([`Robot::recover`]) and go on from the measured pose; off
     /// (`--no-recover`), a broken link ends the task with an error.
     pub recover: bool,
+    /// The camera's lens (`--intrinsics FILE`); `None`: the scene's `camera.intrinsics`, if
+    /// any, else an ideal pinhole.
+    pub lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
 impl Default for LiveOptions {
@@ -83,6 +86,7 @@ impl Default for LiveOptions {
             view_dir: None,
             link: LinkOptions::default(),
             recover: true,
+            lens: None,
         }
     }
 }
@@ -173,9 +177,10 @@ impl LiveRobot {
             .with_context(|| format!("opening the camera {camera}"))?;
         let layout = MarkerLayout::from_scene(scene);
         let families = layout.families();
+        let lens = opts.lens.or(scene.camera.lens);
         let calibration = match &opts.calibration {
             Some(c) => c.clone(),
-            None => calibrate(&grabber, &layout, opts.detector, opts.frame_timeout)?,
+            None => calibrate(&grabber, &layout, opts.detector, opts.frame_timeout, lens)?,
         };
         let detector = make_detector(opts.detector, &families)?;
         let params = TrackerParams {
@@ -185,6 +190,10 @@ impl LiveRobot {
             ..TrackerParams::default()
         };
         let pipeline = Pipeline::new(detector, layout, calibration, params);
+        let pipeline = match lens {
+            Some(l) => pipeline.with_lens(l),
+            None => pipeline,
+        };
         let view = match &opts.view_dir {
             Some(d) => Some(super::view::LiveView::create(d)?),
             None => None,
@@ -427,12 +436,14 @@ fn faulted_refusal(e: &anyhow::Error) -> Option<pushbot_protocol::Faults> {
     }
 }
 
-/// Fit the camera's calibration from a few frames of the scene's calibration markers.
+/// Fit the camera's calibration from a few frames of the scene's calibration markers (their
+/// corners undistorted first when the camera has a `lens`, which must fit the frames).
 fn calibrate(
     grabber: &FrameGrabber,
     layout: &MarkerLayout,
     kind: DetectorKind,
     timeout: Duration,
+    lens: Option<pushbot_world::lens::Intrinsics>,
 ) -> Result<Calibration> {
     let mut det = make_detector(kind, &layout.families())?;
     let mut frames = Vec::new();
@@ -442,7 +453,16 @@ fn calibrate(
         let (n, frame) = grabber.next_after(after, timeout)?;
         after = n;
         size = [frame.width, frame.height];
-        frames.push(det.detect(&frame)?);
+        let dets = det.detect(&frame)?;
+        frames.push(match &lens {
+            Some(l) => {
+                if let Some(why) = crate::vision::undistort::lens_mismatch(l, size) {
+                    bail!("{why}");
+                }
+                crate::vision::undistort::undistort_detections(&dets, l)
+            }
+            None => dets,
+        });
     }
     Calibration::fit(&frames, layout, size).context("calibrating the camera")
 }

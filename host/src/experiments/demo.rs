@@ -62,6 +62,8 @@ pub struct DemoOptions {
     pub link: LinkOptions,
     /// Recover a broken link and go on (`--no-recover` turns it off).
     pub recover: bool,
+    /// The camera's lens (`--intrinsics`); `None`: each stage scene's own, if any.
+    pub lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
 /// Run the demo's stages into a report; a stage that fails is recorded as failed and the next
@@ -184,6 +186,7 @@ impl Ctx<'_> {
             view_dir: self.opts.view.then(|| self.opts.out.join("live")),
             link: self.opts.link.clone(),
             recover: self.opts.recover,
+            lens: self.opts.lens,
             ..LiveOptions::default()
         };
         match &self.opts.robot {
@@ -196,8 +199,13 @@ impl Ctx<'_> {
                 Ok((out?, trace))
             }
             None => {
+                // The built-in camera is seen through the lens the host is told of.
+                let mut seen = scene.clone();
+                if self.opts.lens.is_some() {
+                    seen.camera.lens = self.opts.lens;
+                }
                 let target =
-                    SimTarget::start(scene, self.opts.seed, speed, None, self.opts.faults)?;
+                    SimTarget::start(&seen, self.opts.seed, speed, None, self.opts.faults)?;
                 self.log(&format!(
                     "simulated target: serial {} camera {}",
                     target.port(),
