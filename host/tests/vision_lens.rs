@@ -69,3 +69,35 @@ fn with_the_true_intrinsics_a_distorted_camera_measures_as_an_ideal_one() {
         "the lens matters: {raw_med} mm without"
     );
 }
+
+/// A measurement that puts a body off the table is dropped before the tracker (a smeared or
+/// half-seen marker read wrong), counted, and the body is never given that pose.
+#[test]
+fn poses_off_the_table_are_dropped_and_counted() {
+    use pushbot::vision::Pipeline;
+    use pushbot::vision::tracking::TrackerParams;
+    let layout = MarkerLayout::default_table();
+    let frames = synth::frames(&layout, 3, 44, &SynthParams::default()).unwrap();
+    let mut det = AprilTagC::new(&layout.families(), &AprilTagCConfig::default()).unwrap();
+    let dets: Vec<_> = frames
+        .iter()
+        .map(|f| det.detect(&f.frame).unwrap())
+        .collect();
+    let cal = synth::calibrate(&dets, &layout, [960, 720]).unwrap();
+    // The same markers, but a table that ends 10 cm from the origin: every body is off it.
+    let mut small = layout.clone();
+    small.table = [0.1, 0.1];
+    for (l, want_off) in [(layout.clone(), false), (small, true)] {
+        let detector =
+            Box::new(AprilTagC::new(&l.families(), &AprilTagCConfig::default()).unwrap());
+        let mut p = Pipeline::new(detector, l, cal.clone(), TrackerParams::default());
+        let r = p.process(&frames[0].frame).unwrap();
+        if want_off {
+            assert!(r.off_table >= 4, "{}", r.off_table);
+            assert!(r.measurements.is_empty() && r.tracked.is_empty());
+        } else {
+            assert_eq!(r.off_table, 0);
+            assert!(r.tracked.len() >= 4 && r.tracked.iter().all(|t| !t.lost));
+        }
+    }
+}

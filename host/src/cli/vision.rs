@@ -206,15 +206,14 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
             let bodies: Vec<String> = line
                 .bodies
                 .iter()
-                .map(|b| {
-                    format!(
-                        "{} ({:.4}, {:.4}, {:.1}°){}",
+                .map(|b| match (b.x, b.y, b.theta) {
+                    (Some(x), Some(y), Some(theta)) => format!(
+                        "{} ({x:.4}, {y:.4}, {:.1}°){}",
                         b.id,
-                        b.x,
-                        b.y,
-                        b.theta.to_degrees(),
+                        theta.to_degrees(),
                         if b.seen { "" } else { " unseen" }
-                    )
+                    ),
+                    _ => format!("{} lost", b.id),
                 })
                 .collect();
             format!("t={:.3}s {}", line.time, bodies.join("  "))

@@ -108,7 +108,13 @@ pub struct FrameResult {
     /// Whether the whole frame was searched (rather than only regions around the predicted
     /// markers).
     pub full_frame: bool,
+    /// Measurements dropped because they put a body off the table (a smeared or half-seen
+    /// marker read wrong): never handed to the tracker.
+    pub off_table: usize,
 }
+
+/// How far past the table's edge a body's centre may be measured, metres.
+pub const OFF_TABLE_MARGIN: f64 = 0.05;
 
 /// Tracker-guided regions of interest: between full-frame searches, markers are looked for
 /// only in squares around where each body's marker is predicted to be (constant velocity in
@@ -358,7 +364,15 @@ impl Pipeline {
 
     /// Process one frame.
     pub fn process(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
-        let (detections, measurements, full_frame) = self.look(frame)?;
+        let (detections, mut measurements, full_frame) = self.look(frame)?;
+        let [w, d] = self.layout.table;
+        let m = OFF_TABLE_MARGIN;
+        let before = measurements.len();
+        measurements.retain(|ms| {
+            let p = &ms.body_pose;
+            (-m..=w + m).contains(&p.x) && (-m..=d + m).contains(&p.y) && p.theta.is_finite()
+        });
+        let off_table = before - measurements.len();
         self.remember(frame.time, &detections, &measurements);
         let obs: Vec<(String, Pose)> = measurements
             .iter()
@@ -372,6 +386,7 @@ impl Pipeline {
             measurements,
             tracked,
             full_frame,
+            off_table,
         })
     }
 }
@@ -392,16 +407,18 @@ pub struct TrackLine {
 pub struct TrackBody {
     /// The body's name.
     pub id: String,
-    /// x, metres.
-    pub x: f64,
-    /// y, metres.
-    pub y: f64,
-    /// Heading, radians.
-    pub theta: f64,
+    /// x, metres; `null` when the body is lost.
+    pub x: Option<f64>,
+    /// y, metres; `null` when lost.
+    pub y: Option<f64>,
+    /// Heading, radians; `null` when lost.
+    pub theta: Option<f64>,
     /// Whether its marker was detected (and accepted) in this frame.
     pub seen: bool,
     /// Seconds since its last accepted detection.
     pub age: f64,
+    /// Whether the tracker has lost it ([`tracking`]): no pose, rather than a guess.
+    pub lost: bool,
 }
 
 impl From<&FrameResult> for TrackLine {
@@ -414,11 +431,12 @@ impl From<&FrameResult> for TrackLine {
                 .iter()
                 .map(|t| TrackBody {
                     id: t.body.clone(),
-                    x: t.pose.x,
-                    y: t.pose.y,
-                    theta: t.pose.theta,
+                    x: (!t.lost).then_some(t.pose.x),
+                    y: (!t.lost).then_some(t.pose.y),
+                    theta: (!t.lost).then_some(t.pose.theta),
                     seen: t.seen && !t.rejected,
                     age: t.age,
+                    lost: t.lost,
                 })
                 .collect(),
         }

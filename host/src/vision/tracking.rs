@@ -5,6 +5,11 @@
 //! observation whose innovation fails a χ² gate is rejected as an outlier, unless the body has
 //! been rejected several frames running (it really moved: the filter restarts there). Every
 //! pose carries the time of the frame it is for and the age of its last accepted detection.
+//!
+//! A body the filter can no longer place is **lost** (issue 20): no accepted detection for
+//! [`TrackerParams::lost_after`], or a position uncertainty (1 σ, from the covariance) past
+//! [`TrackerParams::lost_sigma`]. A lost body's pose is a guess that grows without bound; users
+//! of the tracker report lost instead of a pose.
 
 use std::collections::BTreeMap;
 
@@ -36,6 +41,20 @@ pub struct TrackerParams {
     pub gate: f64,
     /// Consecutive rejections after which the filter restarts at the observation.
     pub restart_after: u32,
+    /// Seconds without an accepted detection after which a body is lost.
+    #[serde(default = "default_lost_after")]
+    pub lost_after: f64,
+    /// Position uncertainty (1 σ, metres) past which a body is lost.
+    #[serde(default = "default_lost_sigma")]
+    pub lost_sigma: f64,
+}
+
+fn default_lost_after() -> f64 {
+    0.5
+}
+
+fn default_lost_sigma() -> f64 {
+    0.02
 }
 
 impl Default for TrackerParams {
@@ -47,6 +66,8 @@ impl Default for TrackerParams {
             ang_accel_sigma: 10.0,
             gate: 16.27,
             restart_after: 4,
+            lost_after: default_lost_after(),
+            lost_sigma: default_lost_sigma(),
         }
     }
 }
@@ -154,6 +175,10 @@ pub struct TrackedPose {
     pub rejected: bool,
     /// Seconds since the last accepted detection.
     pub age: f64,
+    /// Position uncertainty, metres (1 σ, the mean of the covariance's x and y variances).
+    pub sigma_m: f64,
+    /// Whether the body is lost (see the module docs): `pose` is then no measurement.
+    pub lost: bool,
 }
 
 /// Kalman filters for every body seen so far.
@@ -256,13 +281,21 @@ impl Tracker {
                 }
             };
             let s = track.est.state();
+            let c = track.est.covariance();
+            let sigma_m = (0.5 * (c[(0, 0)] + c[(1, 1)])).max(0.0).sqrt();
+            let age = time - track.last_seen;
             out.push(TrackedPose {
                 body: name.clone(),
                 pose: Pose::new(s[0], s[1], wrap_angle(s[2])),
                 time,
                 seen: obs.is_some(),
                 rejected,
-                age: time - track.last_seen,
+                age,
+                sigma_m,
+                lost: age > self.params.lost_after
+                    || sigma_m.is_nan()
+                    || sigma_m > self.params.lost_sigma
+                    || !s.iter().all(|v| v.is_finite()),
             });
             self.tracks.insert(name, track);
         }
@@ -367,6 +400,34 @@ mod tests {
             filt_err / n as f64,
             raw_err / n as f64
         );
+    }
+
+    /// A body that stops being seen is lost after `lost_after` (its pose a guess), and found
+    /// again with its next detection.
+    #[test]
+    fn a_body_unseen_for_too_long_is_lost_then_found() {
+        let mut tracker = Tracker::new(TrackerParams::default());
+        let z = |x: f64| ("o".to_string(), Pose::new(x, 0.3, 0.0));
+        for k in 0..30 {
+            let out = tracker.update(k as f64 / 30.0, &[z(0.2 + 0.005 * k as f64)]);
+            assert!(!out[0].lost && out[0].sigma_m < 0.002, "{:?}", out[0]);
+        }
+        let mut lost_at = None;
+        for k in 30..60 {
+            let out = tracker.update(k as f64 / 30.0, &[]);
+            if out[0].lost && lost_at.is_none() {
+                lost_at = Some(k);
+            }
+            if let Some(at) = lost_at {
+                assert!(out[0].lost, "stays lost ({k}, lost at {at})");
+            }
+        }
+        let at = lost_at.expect("lost");
+        // Not for a frame or two missed, and at the latest after `lost_after` (0.5 s, 15
+        // frames); the 2 cm uncertainty bound comes first here.
+        assert!((33..=45).contains(&at), "lost at frame {at}");
+        let out = tracker.update(2.0, &[z(0.5)]);
+        assert!(!out[0].lost, "found again: {:?}", out[0]);
     }
 
     /// A body that really jumps is picked up again after a few rejected frames.
