@@ -10,6 +10,7 @@ pub mod experiments;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
+pub mod recording;
 pub mod plot;
 pub mod report;
 pub mod robot;

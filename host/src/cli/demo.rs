@@ -67,6 +67,14 @@ pub struct DemoArgs {
     /// with detected markers, tracked poses and the current path, refreshed after every look).
     #[arg(long)]
     pub view: bool,
+    /// Record the run into this MCAP file (default OUT/run.mcap): camera, detections, tracked
+    /// poses, scene, paths, telemetry, logs, in Foxglove's schemas (open it in Foxglove, or
+    /// `pushbot replay FILE`).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// Do not record the run.
+    #[arg(long, conflicts_with = "record")]
+    pub no_record: bool,
 }
 
 /// The scene a stage runs on: `--scene STAGE=…` or the default.
@@ -156,6 +164,11 @@ fn run_stages(
         cache: args.cache.clone(),
         view: args.view,
         quiet: g.json,
+        record: (!args.no_record).then(|| {
+            args.record
+                .clone()
+                .unwrap_or_else(|| args.out.join("run.mcap"))
+        }),
     };
     let t0 = Instant::now();
     if args.view && !g.json {
@@ -172,6 +185,7 @@ fn run_stages(
             "success": ok,
             "wall_s": t0.elapsed().as_secs_f64(),
             "stages": report.stages(),
+            "recording": opts.record,
         });
         println!("{v}");
     } else {
@@ -184,6 +198,9 @@ fn run_stages(
             );
         }
         println!("report: {}", page.display());
+        if let Some(r) = &opts.record {
+            println!("recording: {}", r.display());
+        }
     }
     Ok(if ok {
         Status::Success

@@ -60,6 +60,8 @@ pub struct LiveOptions {
     pub view_dir: Option<std::path::PathBuf>,
     /// The serial link's settings.
     pub link: LinkOptions,
+    /// Record every look, the robot's telemetry and events into this MCAP recording.
+    pub recording: Option<crate::recording::RecordingHandle>,
 }
 
 impl Default for LiveOptions {
@@ -77,6 +79,7 @@ impl Default for LiveOptions {
             watchdog_ms: 1000,
             view_dir: None,
             link: LinkOptions::default(),
+            recording: None,
         }
     }
 }
@@ -105,6 +108,7 @@ pub struct LiveRobot {
     host_adjust: f64,
     frames_seen: u64,
     view: Option<super::view::LiveView>,
+    recording: Option<crate::recording::live::LiveRecording>,
 }
 
 impl std::fmt::Debug for LiveRobot {
@@ -176,6 +180,12 @@ impl LiveRobot {
             restart_after: 1,
             ..TrackerParams::default()
         };
+        let recording = opts.recording.as_ref().map(|h| {
+            let d = opts.detector;
+            crate::recording::live::LiveRecording::start(
+                h, &robot, scene, &layout, &calibration, params, d,
+            )
+        });
         let pipeline = Pipeline::new(detector, layout, calibration, params);
         let view = match &opts.view_dir {
             Some(d) => Some(super::view::LiveView::create(d)?),
@@ -196,6 +206,7 @@ impl LiveRobot {
             host_adjust: 0.0,
             frames_seen: 0,
             view,
+            recording,
             opts,
         };
         live.look()?;
@@ -256,6 +267,9 @@ impl LiveRobot {
                 && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
             {
                 tracing::warn!("live view: {e:#}");
+            }
+            if let Some(rec) = &self.recording {
+                rec.look(&self.robot, &frame, &r, self.pipeline.calibration());
             }
             for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
                 let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
@@ -441,5 +455,11 @@ impl RobotIo for LiveRobot {
 
     fn workspace(&self) -> Workspace {
         self.workspace
+    }
+
+    fn show_path(&mut self, path: &[[f64; 2]]) {
+        if let Some(v) = self.view.as_mut() {
+            v.plan = path.to_vec();
+        }
     }
 }

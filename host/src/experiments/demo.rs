@@ -53,6 +53,8 @@ pub struct DemoOptions {
     pub view: bool,
     /// No progress bars (`--json`).
     pub quiet: bool,
+    /// Record the run into this MCAP file (Foxglove schemas; see [`crate::recording`]).
+    pub record: Option<PathBuf>,
 }
 
 /// Run the demo's stages into a report; a stage that fails is recorded as failed and the next
@@ -61,7 +63,18 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
     let report = Report::create(&opts.out, "pushbot demo", opts.png)?;
     let log = std::fs::File::create(opts.out.join("demo.log"))
         .map_err(|e| anyhow!("creating demo.log: {e}"))?;
-    let mut ctx = Ctx { opts, report, log };
+    let recording = match &opts.record {
+        Some(path) => Some(crate::recording::RecordingHandle::new(
+            crate::recording::Recording::create(path)?,
+        )),
+        None => None,
+    };
+    let mut ctx = Ctx {
+        opts,
+        report,
+        log,
+        recording,
+    };
     for stage in &opts.stages {
         let started = std::time::Instant::now();
         let result = match stage.as_str() {
@@ -90,6 +103,9 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
         ctx.report.add(rep);
     }
     let page = ctx.report.write()?;
+    if let Some(h) = &ctx.recording {
+        h.finish()?;
+    }
     Ok((ctx.report, page))
 }
 
@@ -98,11 +114,15 @@ struct Ctx<'a> {
     opts: &'a DemoOptions,
     report: Report,
     log: std::fs::File,
+    recording: Option<crate::recording::RecordingHandle>,
 }
 
 impl Ctx<'_> {
     fn log(&mut self, line: &str) {
         let _ = writeln!(self.log, "{line}");
+        if let Some(h) = &self.recording {
+            h.with(|r| r.log(2, "demo", line));
+        }
         tracing::info!("{line}");
     }
 
@@ -138,12 +158,14 @@ impl Ctx<'_> {
             object: object.map(str::to_owned),
             watchdog_ms: (1000.0 * speed.max(1.0)).min(5000.0) as u16,
             view_dir: self.opts.view.then(|| self.opts.out.join("live")),
+            recording: self.recording.clone(),
             ..LiveOptions::default()
         };
         match &self.opts.robot {
             Some((port, camera)) => {
                 let mut live = LiveRobot::connect(port, camera, scene, opts)?;
-                let mut rec = Recorder::new(&mut live, ids, None);
+                let mut rec =
+                    Recorder::new(&mut live, ids, None).with_recording(self.recording.clone());
                 let out = f(&mut rec)?;
                 Ok((out, rec.into_trace()))
             }
@@ -166,7 +188,8 @@ impl Ctx<'_> {
                             .collect();
                         (Pose2::new(t.x, t.y, t.theta), objects)
                     });
-                    let mut rec = Recorder::new(&mut live, ids, Some(probe));
+                    let mut rec = Recorder::new(&mut live, ids, Some(probe))
+                        .with_recording(self.recording.clone());
                     let out = f(&mut rec);
                     out.map(|o| (o, rec.into_trace()))
                 };
