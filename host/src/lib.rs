@@ -10,8 +10,8 @@ pub mod experiments;
 pub mod link;
 pub mod mechanics;
 pub mod planner;
-pub mod recording;
 pub mod plot;
+pub mod recording;
 pub mod report;
 pub mod robot;
 #[cfg(feature = "sim")]

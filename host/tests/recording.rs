@@ -112,7 +112,10 @@ fn a_cut_recording_reads_up_to_its_last_whole_chunk() {
         // What it reads is what the whole file holds, in order.
         assert!(cut.messages.len() <= whole.messages.len());
         assert_eq!(cut.messages[..], whole.messages[..cut.messages.len()]);
-        assert!(cut.messages.len() >= longest, "more file, no fewer messages");
+        assert!(
+            cut.messages.len() >= longest,
+            "more file, no fewer messages"
+        );
         longest = cut.messages.len();
     }
     // Near the end, every camera look but the last is there (a look ends a chunk).

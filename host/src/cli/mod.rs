@@ -199,10 +199,7 @@ pub const EXAMPLES: &[(&str, &str)] = &[
         "track",
         "pushbot track --camera sim:127.0.0.1:5600 --scene lau-irregular --frames 100 --json",
     ),
-    (
-        "replay",
-        "pushbot replay pushbot-demo/run.mcap --json",
-    ),
+    ("replay", "pushbot replay pushbot-demo/run.mcap --json"),
     ("bench", "pushbot bench stable --repeat 3"),
     ("bench rearrange", "pushbot bench rearrange --quick"),
     ("bench stable", "pushbot bench stable --repeat 3 --json"),

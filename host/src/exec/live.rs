@@ -183,7 +183,13 @@ impl LiveRobot {
         let recording = opts.recording.as_ref().map(|h| {
             let d = opts.detector;
             crate::recording::live::LiveRecording::start(
-                h, &robot, scene, &layout, &calibration, params, d,
+                h,
+                &robot,
+                scene,
+                &layout,
+                &calibration,
+                params,
+                d,
             )
         });
         let pipeline = Pipeline::new(detector, layout, calibration, params);

@@ -125,7 +125,11 @@ pub fn overlay_svg(
     for ((a, label, colour), at) in marks.iter().zip(spots) {
         // A leader line from the body to a label moved away from it.
         if (at[0] - a[0]).abs() > 12.0 || (at[1] - a[1]).abs() > 2.0 * LABEL_FONT {
-            d.line(*a, [at[0], at[1] - LABEL_FONT * 0.4], &Style::new().stroke(colour).width(1.0));
+            d.line(
+                *a,
+                [at[0], at[1] - LABEL_FONT * 0.4],
+                &Style::new().stroke(colour).width(1.0),
+            );
         }
         d.text(at, label, &Style::new().fill(colour).font_size(LABEL_FONT));
     }

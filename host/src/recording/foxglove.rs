@@ -93,7 +93,11 @@ pub fn image_annotations(ns: u64, result: &FrameResult, cal: &Calibration) -> Va
     let mut texts = Vec::new();
     let mut circles = Vec::new();
     for d in &result.detections {
-        let pts: Vec<Value> = d.corners.iter().map(|c| json!({"x": c[0], "y": c[1]})).collect();
+        let pts: Vec<Value> = d
+            .corners
+            .iter()
+            .map(|c| json!({"x": c[0], "y": c[1]}))
+            .collect();
         points.push(json!({"timestamp": t, "type": 2, "points": pts,
                            "outline_color": green, "thickness": 2.0}));
     }
@@ -113,13 +117,18 @@ pub fn image_annotations(ns: u64, result: &FrameResult, cal: &Calibration) -> Va
         anchors.push((p, tr.body.clone(), c));
     }
     let placed = crate::exec::view::place_labels(
-        &anchors.iter().map(|(p, s, _)| (*p, s.len())).collect::<Vec<_>>(),
+        &anchors
+            .iter()
+            .map(|(p, s, _)| (*p, s.len()))
+            .collect::<Vec<_>>(),
         16.0,
     );
     for ((_, text, c), pos) in anchors.into_iter().zip(placed) {
-        texts.push(json!({"timestamp": t, "position": {"x": pos[0], "y": pos[1]},
+        texts.push(
+            json!({"timestamp": t, "position": {"x": pos[0], "y": pos[1]},
                           "text": text, "font_size": 16.0, "text_color": c,
-                          "background_color": color(0.0, 0.0, 0.0, 0.6)}));
+                          "background_color": color(0.0, 0.0, 0.0, 0.6)}),
+        );
     }
     json!({"circles": circles, "points": points, "texts": texts})
 }
@@ -229,7 +238,13 @@ pub fn scene_update(ns: u64, scene: &Scene) -> Value {
         true,
         vec![
             line(1, &disc, 0.0, 0.003, color(0.1, 0.4, 1.0, 1.0)),
-            line(0, &[[0.0, 0.0], [r, 0.0]], 0.0, 0.003, color(0.1, 0.4, 1.0, 1.0)),
+            line(
+                0,
+                &[[0.0, 0.0], [r, 0.0]],
+                0.0,
+                0.003,
+                color(0.1, 0.4, 1.0, 1.0),
+            ),
         ],
     ));
     json!({"deletions": [], "entities": ents})

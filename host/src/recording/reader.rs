@@ -49,18 +49,19 @@ pub fn read_bytes(bytes: &[u8]) -> Result<Contents> {
     if bytes.len() < mcap::MAGIC.len() || !bytes.starts_with(mcap::MAGIC) {
         bail!("not an MCAP file (it does not start with the MCAP magic bytes)");
     }
-    let stream = mcap::MessageStream::new_with_options(
-        bytes,
-        mcap::read::Options::IgnoreEndMagic.into(),
-    )
-    .map_err(|e| anyhow!("{e}"))?;
+    let stream =
+        mcap::MessageStream::new_with_options(bytes, mcap::read::Options::IgnoreEndMagic.into())
+            .map_err(|e| anyhow!("{e}"))?;
     let mut messages = Vec::new();
     let mut cut = None;
     for m in stream {
         let m = match m {
             Ok(m) => m,
             Err(e) => {
-                cut = Some(format!("the file is cut short or damaged after {} messages: {e}", messages.len()));
+                cut = Some(format!(
+                    "the file is cut short or damaged after {} messages: {e}",
+                    messages.len()
+                ));
                 break;
             }
         };

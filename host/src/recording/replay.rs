@@ -214,7 +214,9 @@ fn compare(s: &mut SessionReplay, r: &crate::vision::FrameResult, recorded: &Val
         let d = (num("x") - t.pose.x).hypot(num("y") - t.pose.y);
         let a = crate::strategy::sample::wrap_angle(num("theta") - t.pose.theta).abs();
         s.max_diff_m = s.max_diff_m.max(if d.is_nan() { f64::INFINITY } else { d });
-        s.max_diff_rad = s.max_diff_rad.max(if a.is_nan() { f64::INFINITY } else { a });
+        s.max_diff_rad = s
+            .max_diff_rad
+            .max(if a.is_nan() { f64::INFINITY } else { a });
         if t.seen && !t.rejected {
             let p = BodyPose {
                 t: t.time,

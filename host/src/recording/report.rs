@@ -66,7 +66,12 @@ pub fn write(replay: &Replay, dir: &Path, recording: &Path) -> Result<PathBuf> {
             if !tracked.is_empty() {
                 let f = report.figure(
                     &format!("session-{}-tracked", s.session),
-                    &figure::run_svg(scene, &tracked, &format!("{} tracked again", s.label), false),
+                    &figure::run_svg(
+                        scene,
+                        &tracked,
+                        &format!("{} tracked again", s.label),
+                        false,
+                    ),
                 )?;
                 st.figures.push((
                     f,

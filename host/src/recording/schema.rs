@@ -63,11 +63,17 @@ fn point2() -> Value {
 }
 
 fn vector3() -> Value {
-    obj("foxglove.Vector3", json!({"x": num(), "y": num(), "z": num()}))
+    obj(
+        "foxglove.Vector3",
+        json!({"x": num(), "y": num(), "z": num()}),
+    )
 }
 
 fn point3() -> Value {
-    obj("foxglove.Point3", json!({"x": num(), "y": num(), "z": num()}))
+    obj(
+        "foxglove.Point3",
+        json!({"x": num(), "y": num(), "z": num()}),
+    )
 }
 
 fn quaternion() -> Value {
@@ -174,7 +180,10 @@ pub fn scene_update() -> Value {
         json!({"pose": pose(), "billboard": boolean(), "font_size": num(),
                "scale_invariant": boolean(), "color": color(), "text": string()}),
     );
-    let kv = obj("foxglove.KeyValuePair", json!({"key": string(), "value": string()}));
+    let kv = obj(
+        "foxglove.KeyValuePair",
+        json!({"key": string(), "value": string()}),
+    );
     let entity = obj(
         "foxglove.SceneEntity",
         json!({"timestamp": time(), "frame_id": string(), "id": string(),

@@ -123,8 +123,8 @@ impl Recording {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("creating the folder of {}", path.display()))?;
         }
-        let file =
-            File::create(path).with_context(|| format!("creating the recording {}", path.display()))?;
+        let file = File::create(path)
+            .with_context(|| format!("creating the recording {}", path.display()))?;
         let mut writer = mcap::WriteOptions::new()
             .compression(None)
             .profile("")
@@ -144,7 +144,9 @@ impl Recording {
                 .map_err(|e| anyhow!("writing channel {topic}: {e}"))?;
             ids.insert(topic, id);
         }
-        writer.flush().map_err(|e| anyhow!("writing {}: {e}", path.display()))?;
+        writer
+            .flush()
+            .map_err(|e| anyhow!("writing {}: {e}", path.display()))?;
         Ok(Recording {
             writer,
             path: path.to_path_buf(),
@@ -206,7 +208,11 @@ impl Recording {
     /// calibration and the tracker's settings.
     pub fn begin_session(&mut self, info: &SessionInfo<'_>, robot_us: u64) -> Result<()> {
         self.session += 1;
-        let start = if self.session == 1 { 0 } else { self.last_ns + 1_000_000 };
+        let start = if self.session == 1 {
+            0
+        } else {
+            self.last_ns + 1_000_000
+        };
         self.offset_ns = i128::from(start) - i128::from(robot_us) * 1000;
         self.executed.clear();
         let ns = self.at(robot_us);
@@ -226,7 +232,12 @@ impl Recording {
             ns,
             &foxglove::camera_calibration(ns, info.calibration),
         )?;
-        self.log_at(ns, 2, "session", &format!("session {}: {}", self.session, info.label))?;
+        self.log_at(
+            ns,
+            2,
+            "session",
+            &format!("session {}: {}", self.session, info.label),
+        )?;
         self.flush()
     }
 
@@ -281,7 +292,11 @@ impl Recording {
             let u = foxglove::path_update(ns, &format!("executed-{body}"), pts, c);
             ents.extend(u["entities"].as_array().cloned().unwrap_or_default());
         }
-        self.put(topics::EXECUTED, ns, &json!({"deletions": [], "entities": ents}))?;
+        self.put(
+            topics::EXECUTED,
+            ns,
+            &json!({"deletions": [], "entities": ents}),
+        )?;
         self.frames += 1;
         self.flush()
     }

@@ -1,7 +1,10 @@
 //! A run drawn on its table, as the papers draw executed pushes (Lau et al. Fig. 8; Ben-Shahar &
 //! Rivlin's step-by-step figures; Lynch & Mason Fig. 13–18): obstacles, goals, every object's
 //! outline where it started (dashed) and where it ended (solid), the object paths (red) and the
-//! robot's path (blue), with the robot drawn at the start and at the end.
+//! robot's path (blue), with the robot drawn at the start and at the end. Each path is drawn
+//! so that what went wrong shows: a dot at every trace point (after each primitive) so loops
+//! and back-and-forth read as such, the robot's path shaded from light (early) to dark (late),
+//! and a ring where the robot stalled (a primitive ran and it did not move); axes in metres.
 
 use pushbot_world::Scene;
 use pushbot_world::scene::placed;
@@ -14,6 +17,50 @@ use crate::strategy::sample::Pose2;
 const SCALE: f64 = 600.0;
 /// Room above the table for the title.
 const BAND: f64 = 28.0;
+/// Room around the table for the axes' ticks and labels, pixels.
+const MARGIN: f64 = 44.0;
+/// A robot that moved less than this between two trace points stalled, m.
+const STALL_M: f64 = 0.002;
+
+/// A tick step (0.05, 0.1, 0.2, 0.5 m …) giving about five to ten ticks over `span` metres.
+pub fn tick_step(span: f64) -> f64 {
+    let raw = (span / 8.0).max(1e-6);
+    let mag = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag)
+}
+
+/// Axes in metres along the bottom and left edges of `f`'s plane (`min`–`max`, metres): ticks,
+/// their values, and the unit.
+pub fn metre_axes(d: &mut Doc, f: &Frame, min: [f64; 2], max: [f64; 2]) {
+    let ink = Style::new().stroke("#444").width(1.0);
+    let label = Style::new().fill("#333").font_size(11.0);
+    for axis in 0..2 {
+        let step = tick_step(max[axis] - min[axis]);
+        let mut v = (min[axis] / step).ceil() * step;
+        while v <= max[axis] + 1e-9 {
+            let (p, q, at, anchor) = if axis == 0 {
+                let p = f.map([v, min[1]]);
+                (p, [p[0], p[1] + 5.0], [p[0], p[1] + 17.0], "middle")
+            } else {
+                let p = f.map([min[0], v]);
+                (p, [p[0] - 5.0, p[1]], [p[0] - 7.0, p[1] + 4.0], "end")
+            };
+            d.line(p, q, &ink);
+            d.text(at, &format!("{v:.2}"), &label.clone().anchor(anchor));
+            v += step;
+        }
+    }
+    let corner = f.map([max[0], min[1]]);
+    d.text(
+        [corner[0], corner[1] + 32.0],
+        "x, y in metres",
+        &label.anchor("end"),
+    );
+}
 
 fn outline_at(scene: &Scene, id: &str, pose: &Pose2) -> Option<Vec<[f64; 2]>> {
     let o = scene.object(id)?;
@@ -23,7 +70,9 @@ fn outline_at(scene: &Scene, id: &str, pose: &Pose2) -> Option<Vec<[f64; 2]>> {
 /// The run `trace` over `scene`, titled `title`; `truth` draws the simulator's true paths
 /// instead of the camera's when the trace has them.
 pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) -> String {
-    let f = Frame::table(scene.table.width, scene.table.height, SCALE).with_band(BAND);
+    let f = Frame::table(scene.table.width, scene.table.height, SCALE)
+        .with_band(BAND)
+        .with_margin(MARGIN);
     let mut d = Doc::for_frame(&f);
     d.title(title);
     let (at, size) = f.area();
@@ -33,6 +82,12 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
         &Style::new().fill("#f6f6f2").stroke("black").width(2.0),
     );
     d.caption(title, 16.0, &Style::new());
+    metre_axes(
+        &mut d,
+        &f,
+        [0.0, 0.0],
+        [scene.table.width, scene.table.height],
+    );
     for o in &scene.obstacles {
         d.polygon(&f.map_all(&o.outline), &Style::new().fill("#555"));
     }
@@ -79,15 +134,50 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
         }
         let line: Vec<[f64; 2]> = path.iter().map(|p| f.map([p.x, p.y])).collect();
         d.polyline(&line, &Style::outline("red", 2.0).tip(&o.id));
+        for p in &line {
+            d.circle(*p, 2.0, &Style::new().fill("red"));
+        }
     }
     let robot: Vec<[f64; 2]> = poses
         .iter()
         .map(|(r, _)| [r.x, r.y])
         .filter(|p| p[0].is_finite() && p[1].is_finite())
         .collect();
-    d.polyline(
-        &f.map_all(&robot),
-        &Style::outline("blue", 1.2).opacity(0.8),
+    // Early light, late dark: where the path crosses itself, which pass came later shows.
+    let n = robot.len().max(2) - 1;
+    for (i, w) in robot.windows(2).enumerate() {
+        let k = i as f64 / n as f64;
+        let shade = format!(
+            "rgb({},{},{})",
+            (150.0 * (1.0 - k)) as u8,
+            (180.0 * (1.0 - k) + 40.0 * k) as u8,
+            (255.0 * (1.0 - k) + 200.0 * k) as u8
+        );
+        d.line(f.map(w[0]), f.map(w[1]), &Style::outline(&shade, 1.6));
+    }
+    let mut stalls = 0;
+    for (i, p) in robot.iter().enumerate() {
+        let stalled = i > 0 && (p[0] - robot[i - 1][0]).hypot(p[1] - robot[i - 1][1]) < STALL_M;
+        if stalled {
+            stalls += 1;
+            d.circle(
+                f.map(*p),
+                6.0,
+                &Style::outline("#f08c00", 2.0).tip("stalled"),
+            );
+        } else {
+            d.circle(f.map(*p), 1.6, &Style::new().fill("#1c3fa0"));
+        }
+    }
+    let legend = format!(
+        "robot path light (early) to dark (late), a dot per primitive; objects red; {stalls} stall{} (orange rings)",
+        if stalls == 1 { "" } else { "s" }
+    );
+    let (at, size) = f.area();
+    d.text(
+        [at[0], at[1] + size[1] + 32.0],
+        &legend,
+        &Style::new().fill("#333").font_size(11.0),
     );
     let r = f.length(scene.robot.bumper_radius);
     for (p, fill) in [(robot.first(), "#9bb8ff"), (robot.last(), "#3b6cf0")] {
@@ -104,6 +194,30 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_robot_that_does_not_move_is_marked_stalled() {
+        let scene = Scene::preset("bsr-a").expect("preset");
+        let at = |x: f64| TracePoint {
+            t: x,
+            after: "forward",
+            robot: Pose2::new(x, 0.2, 0.0),
+            objects: Vec::new(),
+            truth: None,
+        };
+        let trace = [at(0.2), at(0.3), at(0.3), at(0.3005), at(0.4)];
+        let svg = run_svg(&scene, &trace, "stall", false);
+        assert!(svg.contains("2 stalls"), "{svg}");
+        assert_eq!(svg.matches("<title>stalled</title>").count(), 2);
+    }
+
+    #[test]
+    fn ticks_are_round_and_few() {
+        assert_eq!(tick_step(1.2), 0.2);
+        assert_eq!(tick_step(0.9), 0.2);
+        assert_eq!(tick_step(0.3), 0.05);
+        assert_eq!(tick_step(4.0), 0.5);
+    }
 
     #[test]
     fn draws_obstacles_goals_paths_and_the_robot() {
@@ -125,7 +239,13 @@ mod tests {
         let svg = run_svg(&scene, &[at(0.0), at(0.1), at(0.2)], "A", false);
         assert_eq!(svg.matches("fill=\"#555\"").count(), scene.obstacles.len());
         assert_eq!(svg.matches("stroke=\"red\"").count(), scene.objects.len());
-        assert_eq!(svg.matches("<circle").count(), scene.goals.len() + 2);
+        // Goals, the robot at both ends, a dot per trace point for the robot and each object.
+        assert_eq!(
+            svg.matches("<circle").count(),
+            scene.goals.len() + 2 + 3 * (1 + scene.objects.len())
+        );
+        assert!(svg.contains("x, y in metres"));
+        assert!(svg.contains("0 stalls"));
         assert!(svg.trim_end().ends_with("</svg>"));
     }
 }
