@@ -48,11 +48,12 @@ impl LiveRecording {
         let events = robot.subscribe();
         let info = SessionInfo {
             label: &scene.name,
-            scene,
+            scene: Some(scene),
             layout,
             calibration,
             tracker,
             detector,
+            whole_frames: false,
         };
         handle.with(|r| r.begin_session(&info, robot_us(robot)));
         LiveRecording {

@@ -112,7 +112,14 @@ fn start(v: &Value) -> Result<Live> {
             scene,
             trace: Vec::new(),
         },
-        pipeline: Pipeline::new(det, layout, calibration, tracker),
+        pipeline: {
+            let p = Pipeline::new(det, layout, calibration, tracker);
+            if v.get("whole_frames").and_then(Value::as_bool) == Some(true) {
+                p.with_roi(crate::vision::RoiParams::full_frames())
+            } else {
+                p
+            }
+        },
         image: None,
     })
 }

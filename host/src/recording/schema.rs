@@ -249,7 +249,8 @@ pub fn session() -> Value {
     json!({"title": "pushbot.Session", "type": "object",
            "properties": {"session": int(), "label": string(), "scene": {"type": "object"},
                           "layout": {"type": "object"}, "calibration": {"type": "object"},
-                          "tracker": {"type": "object"}, "detector": string()}})
+                          "tracker": {"type": "object"}, "detector": string(),
+                          "whole_frames": boolean()}})
 }
 
 /// `pushbot.TracePoint`: the robot's and objects' poses after a primitive.

@@ -81,8 +81,8 @@ pub mod topics {
 pub struct SessionInfo<'a> {
     /// What the session is (a demo stage's name, a command's).
     pub label: &'a str,
-    /// The scene on the table.
-    pub scene: &'a Scene,
+    /// The scene on the table, when there is one.
+    pub scene: Option<&'a Scene>,
     /// The marker layout the tracker uses.
     pub layout: &'a crate::vision::layout::MarkerLayout,
     /// The camera's calibration.
@@ -91,6 +91,8 @@ pub struct SessionInfo<'a> {
     pub tracker: crate::vision::tracking::TrackerParams,
     /// The detector.
     pub detector: crate::vision::detect::DetectorKind,
+    /// Whether every frame was searched whole (no regions of interest).
+    pub whole_frames: bool,
 }
 
 /// An MCAP file being written.
@@ -224,9 +226,12 @@ impl Recording {
             "calibration": info.calibration,
             "tracker": info.tracker,
             "detector": info.detector,
+            "whole_frames": info.whole_frames,
         });
         self.put(topics::SESSION, ns, &msg)?;
-        self.put(topics::SCENE, ns, &foxglove::scene_update(ns, info.scene))?;
+        if let Some(scene) = info.scene {
+            self.put(topics::SCENE, ns, &foxglove::scene_update(ns, scene))?;
+        }
         self.put(
             topics::CALIBRATION,
             ns,

@@ -108,6 +108,17 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
         }
     };
     let poses: Vec<(Pose2, Vec<(String, Pose2)>)> = trace.iter().map(pick).collect();
+    // A drive that did not move the robot: a stall (a spin turns in place by design).
+    let stalled: Vec<bool> = trace
+        .iter()
+        .zip(&poses)
+        .enumerate()
+        .map(|(i, (p, (r, _)))| {
+            i > 0
+                && matches!(p.after, "forward" | "drive")
+                && (r.x - poses[i - 1].0.x).hypot(r.y - poses[i - 1].0.y) < STALL_M
+        })
+        .collect();
     for o in &scene.objects {
         let path: Vec<Pose2> = poses
             .iter()
@@ -138,11 +149,12 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
             d.circle(*p, 2.0, &Style::new().fill("red"));
         }
     }
-    let robot: Vec<[f64; 2]> = poses
+    let (robot, stalled): (Vec<[f64; 2]>, Vec<bool>) = poses
         .iter()
-        .map(|(r, _)| [r.x, r.y])
-        .filter(|p| p[0].is_finite() && p[1].is_finite())
-        .collect();
+        .zip(stalled)
+        .map(|((r, _), s)| ([r.x, r.y], s))
+        .filter(|(p, _)| p[0].is_finite() && p[1].is_finite())
+        .unzip();
     // Early light, late dark: where the path crosses itself, which pass came later shows.
     let n = robot.len().max(2) - 1;
     for (i, w) in robot.windows(2).enumerate() {
@@ -156,9 +168,8 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
         d.line(f.map(w[0]), f.map(w[1]), &Style::outline(&shade, 1.6));
     }
     let mut stalls = 0;
-    for (i, p) in robot.iter().enumerate() {
-        let stalled = i > 0 && (p[0] - robot[i - 1][0]).hypot(p[1] - robot[i - 1][1]) < STALL_M;
-        if stalled {
+    for (p, stalled) in robot.iter().zip(&stalled) {
+        if *stalled {
             stalls += 1;
             d.circle(
                 f.map(*p),
@@ -170,7 +181,7 @@ pub fn run_svg(scene: &Scene, trace: &[TracePoint], title: &str, truth: bool) ->
         }
     }
     let legend = format!(
-        "robot path light (early) to dark (late), a dot per primitive; objects red; {stalls} stall{} (orange rings)",
+        "robot path light (early) to dark (late), a dot per primitive; objects red; {stalls} stall{} (a drive that did not move the robot: orange rings)",
         if stalls == 1 { "" } else { "s" }
     );
     let (at, size) = f.area();

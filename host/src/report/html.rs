@@ -12,6 +12,9 @@ use super::StageReport;
 
 /// Figures narrower than this are shown scaled up to it, pixels.
 const MIN_FIGURE_PX: f64 = 480.0;
+/// Figures lower than this are shown scaled up to it (a row of small plan panels), pixels;
+/// the page's width caps both.
+const MIN_FIGURE_HEIGHT_PX: f64 = 360.0;
 
 /// A value for a table cell, as HTML: numbers rounded, records as tables, lists of records as
 /// tables with a column per key, other lists comma-separated.
@@ -159,7 +162,7 @@ figcaption {{ font-size: .9em; color: #555; margin-top: .3em; }}
             // scales it down to the page's width.
             let size = match sizes.get(file) {
                 Some(&[w, hh]) if w > 0.0 && hh > 0.0 => {
-                    let k = (MIN_FIGURE_PX / w).max(1.0);
+                    let k = (MIN_FIGURE_PX / w).max(MIN_FIGURE_HEIGHT_PX / hh).max(1.0);
                     format!(r#" width="{:.0}" height="{:.0}""#, w * k, hh * k)
                 }
                 _ => r#" style="width: 100%""#.to_string(),
