@@ -20,7 +20,11 @@ use pushbot_sim::{Pose, PtySim, Scene, SimOptions};
 
 /// The simulated pushbot robot, served on a pseudo-terminal.
 #[derive(Parser, Debug)]
-#[command(version, about)]
+#[command(
+    version,
+    about,
+    after_help = "Examples:\n  pushbot-sim --seed 3 --speed 5 --truth-log truth.jsonl\n  pushbot-sim --scene lau-irregular --frames frames/ --no-stdin"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Sub>,
@@ -133,6 +137,9 @@ struct FirstLine<'a> {
 enum Sub {
     /// Drive a recorded pusher trajectory against one object of a scene and print the object's
     /// simulated trajectory (quasi-static pushing, no robot dynamics).
+    #[command(
+        after_help = "Example:\n  pushbot-sim replay --scene lynch-mason-fig12 --object slider --pusher pusher.csv --json"
+    )]
     Replay {
         /// Scene: preset name or TOML file.
         #[arg(long, value_name = "PRESET|FILE")]
@@ -146,9 +153,11 @@ enum Sub {
         pusher: PathBuf,
     },
     /// List the built-in scene presets.
+    #[command(after_help = "Example:\n  pushbot-sim presets")]
     Presets,
     /// Measure how fast the in-process simulation runs (robot + firmware + a scene's objects,
     /// the robot driving and pushing), and print one JSON object.
+    #[command(after_help = "Example:\n  pushbot-sim bench --scene three-boxes --seconds 30 --seed 3")]
     Bench {
         /// Scene: preset name or TOML file.
         #[arg(long, default_value = "three-boxes")]

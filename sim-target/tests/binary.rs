@@ -248,3 +248,25 @@ fn global_flags_before_or_after_the_subcommand() {
     assert_eq!(stray.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&stray.stderr).contains("--speed"));
 }
+
+/// Every `--help` ends with an example that names the binary.
+#[test]
+fn every_help_has_an_example() {
+    for args in [
+        &["--help"][..],
+        &["bench", "--help"],
+        &["replay", "--help"],
+        &["presets", "--help"],
+    ] {
+        let out = Process::new(env!("CARGO_BIN_EXE_pushbot-sim"))
+            .args(args)
+            .output()
+            .expect("run");
+        let text = String::from_utf8_lossy(&out.stdout);
+        let (_, ex) = text
+            .split_once("\nExample:\n")
+            .or_else(|| text.split_once("\nExamples:\n"))
+            .unwrap_or_else(|| panic!("{args:?}: no example in {text}"));
+        assert!(ex.trim_start().starts_with("pushbot-sim"), "{args:?}: {ex}");
+    }
+}
