@@ -157,7 +157,9 @@ enum Sub {
     Presets,
     /// Measure how fast the in-process simulation runs (robot + firmware + a scene's objects,
     /// the robot driving and pushing), and print one JSON object.
-    #[command(after_help = "Example:\n  pushbot-sim bench --scene three-boxes --seconds 30 --seed 3")]
+    #[command(
+        after_help = "Example:\n  pushbot-sim bench --scene three-boxes --seconds 30 --seed 3"
+    )]
     Bench {
         /// Scene: preset name or TOML file.
         #[arg(long, default_value = "three-boxes")]

@@ -347,7 +347,7 @@ fn stage_rearrange(
 ) -> Result<StageReport> {
     use crate::exec::rearrange::{ExecOptions, execute};
     use crate::planner::rearrange::to_scene::{SceneOptions, scene_for};
-    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg};
+    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg_in};
 
     let mut st = StageReport::new(
         "rearrange",
@@ -366,11 +366,16 @@ fn stage_rearrange(
     let plan = restore(&model, &map, start).map_err(|e| anyhow!("{e}"))?;
     st.number("plan_cost", plan.cost);
     st.number("plan_steps", plan.steps.len());
-    let f = ctx
-        .report
-        .figure("rearrange-plan", &plan_svg(&model, &plan))?;
-    st.figures
-        .push((f, format!("The optimal plan of {case}, step by step")));
+    let f = ctx.report.figure(
+        "rearrange-plan",
+        &plan_svg_in(&model, &plan, Some(SceneOptions::default().cell)),
+    )?;
+    st.figures.push((
+        f,
+        format!(
+            "The optimal plan of {case}, step by step (Figs. 9–19 style): robot blue, boxes where each stage leaves them, goals dashed; axes in metres"
+        ),
+    ));
     let scene_opts = SceneOptions::default();
     let scene = scene_for(problem, &scene_opts)?;
     let ids: Vec<String> = scene.objects.iter().map(|o| o.id.clone()).collect();

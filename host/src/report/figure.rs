@@ -10,6 +10,7 @@ use pushbot_world::Scene;
 use pushbot_world::scene::placed;
 
 use crate::exec::record::TracePoint;
+use crate::plot::axes::metre_axes;
 use crate::plot::svg::{Doc, Draw, Frame, Style};
 use crate::strategy::sample::Pose2;
 
@@ -21,46 +22,6 @@ const BAND: f64 = 28.0;
 const MARGIN: f64 = 44.0;
 /// A robot that moved less than this between two trace points stalled, m.
 const STALL_M: f64 = 0.002;
-
-/// A tick step (0.05, 0.1, 0.2, 0.5 m …) giving about five to ten ticks over `span` metres.
-pub fn tick_step(span: f64) -> f64 {
-    let raw = (span / 8.0).max(1e-6);
-    let mag = 10f64.powf(raw.log10().floor());
-    [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * mag)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag)
-}
-
-/// Axes in metres along the bottom and left edges of `f`'s plane (`min`–`max`, metres): ticks,
-/// their values, and the unit.
-pub fn metre_axes(d: &mut Doc, f: &Frame, min: [f64; 2], max: [f64; 2]) {
-    let ink = Style::new().stroke("#444").width(1.0);
-    let label = Style::new().fill("#333").font_size(11.0);
-    for axis in 0..2 {
-        let step = tick_step(max[axis] - min[axis]);
-        let mut v = (min[axis] / step).ceil() * step;
-        while v <= max[axis] + 1e-9 {
-            let (p, q, at, anchor) = if axis == 0 {
-                let p = f.map([v, min[1]]);
-                (p, [p[0], p[1] + 5.0], [p[0], p[1] + 17.0], "middle")
-            } else {
-                let p = f.map([min[0], v]);
-                (p, [p[0] - 5.0, p[1]], [p[0] - 7.0, p[1] + 4.0], "end")
-            };
-            d.line(p, q, &ink);
-            d.text(at, &format!("{v:.2}"), &label.clone().anchor(anchor));
-            v += step;
-        }
-    }
-    let corner = f.map([max[0], min[1]]);
-    d.text(
-        [corner[0], corner[1] + 32.0],
-        "x, y in metres",
-        &label.anchor("end"),
-    );
-}
 
 fn outline_at(scene: &Scene, id: &str, pose: &Pose2) -> Option<Vec<[f64; 2]>> {
     let o = scene.object(id)?;
@@ -220,14 +181,6 @@ mod tests {
         let svg = run_svg(&scene, &trace, "stall", false);
         assert!(svg.contains("2 stalls"), "{svg}");
         assert_eq!(svg.matches("<title>stalled</title>").count(), 2);
-    }
-
-    #[test]
-    fn ticks_are_round_and_few() {
-        assert_eq!(tick_step(1.2), 0.2);
-        assert_eq!(tick_step(0.9), 0.2);
-        assert_eq!(tick_step(0.3), 0.05);
-        assert_eq!(tick_step(4.0), 0.5);
     }
 
     #[test]

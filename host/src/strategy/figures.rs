@@ -22,9 +22,12 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
         .chain(outline.iter().flat_map(|v| [v[0].abs(), v[1].abs()]))
         .fold(0.1f64, f64::max)
         + 0.05;
-    let f = Frame::region([-half, -half], [half, half], 2000.0);
+    let f = Frame::region([-half, -half], [half, half], 2000.0)
+        .with_margin(44.0)
+        .with_band(24.0);
     let mut d = Doc::for_frame(&f);
     d.background(&Style::new().fill("white"));
+    crate::plot::axes::metre_axes(&mut d, &f, [-half, -half], [half, half]);
     d.polygon(
         &f.map_all(outline),
         &Style::new().fill("lightgrey").stroke("black"),
@@ -42,7 +45,14 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
             &Style::new().stroke(&c).width(1.0).opacity(0.6),
         );
     }
-    d.caption(&format!("{} samples", samples.len()), 16.0, &Style::new());
+    d.caption(
+        &format!(
+            "{} samples (object frame, origin at its marker)",
+            samples.len()
+        ),
+        16.0,
+        &Style::new(),
+    );
     d.to_string()
 }
 
