@@ -30,7 +30,7 @@ pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
 /// `pushbot demo`.
 #[derive(Args, Debug, Clone)]
 #[command(
-    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml"
+    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --stages stable --foxglove 127.0.0.1:8765\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml"
 )]
 pub struct DemoArgs {
     /// Folder for the report (created; files in it are replaced).
@@ -75,6 +75,10 @@ pub struct DemoArgs {
     /// Do not record the run.
     #[arg(long, conflicts_with = "record")]
     pub no_record: bool,
+    /// Serve the recording's channels live over the Foxglove WebSocket protocol while the run
+    /// goes (open Foxglove, "Open connection", ws://ADDR); ADDR defaults to 127.0.0.1:8765.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765", conflicts_with = "no_record")]
+    pub foxglove: Option<String>,
 }
 
 /// The scene a stage runs on: `--scene STAGE=…` or the default.
@@ -164,6 +168,7 @@ fn run_stages(
         cache: args.cache.clone(),
         view: args.view,
         quiet: g.json,
+        foxglove: args.foxglove.clone(),
         record: (!args.no_record).then(|| {
             args.record
                 .clone()
@@ -171,6 +176,9 @@ fn run_stages(
         }),
     };
     let t0 = Instant::now();
+    if let Some(addr) = args.foxglove.as_ref().filter(|_| !g.json) {
+        println!("Foxglove live view: open a connection to ws://{addr}");
+    }
     if args.view && !g.json {
         println!(
             "live view: open {} in a browser",

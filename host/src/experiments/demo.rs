@@ -55,6 +55,8 @@ pub struct DemoOptions {
     pub quiet: bool,
     /// Record the run into this MCAP file (Foxglove schemas; see [`crate::recording`]).
     pub record: Option<PathBuf>,
+    /// Serve the recording's channels live to Foxglove on this address (`HOST:PORT`).
+    pub foxglove: Option<String>,
 }
 
 /// Run the demo's stages into a report; a stage that fails is recorded as failed and the next
@@ -64,9 +66,14 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
     let log = std::fs::File::create(opts.out.join("demo.log"))
         .map_err(|e| anyhow!("creating demo.log: {e}"))?;
     let recording = match &opts.record {
-        Some(path) => Some(crate::recording::RecordingHandle::new(
-            crate::recording::Recording::create(path)?,
-        )),
+        Some(path) => {
+            let mut rec = crate::recording::Recording::create(path)?;
+            if let Some(addr) = &opts.foxglove {
+                let at = rec.serve_foxglove(addr)?;
+                tracing::info!("Foxglove live view: connect to ws://{at}");
+            }
+            Some(crate::recording::RecordingHandle::new(rec))
+        }
         None => None,
     };
     let mut ctx = Ctx {

@@ -10,7 +10,8 @@
 //! - [`live`]: what a robot seen by a camera records at every look;
 //! - [`reader`]: a recording read back, a cut one up to its last whole chunk;
 //! - [`replay`]: tracking re-run from a recording, compared with the live run's poses;
-//! - [`report`]: the report of a replay.
+//! - [`report`]: the report of a replay;
+//! - [`ws`]: the same channels served live to Foxglove over its WebSocket protocol.
 
 pub mod foxglove;
 pub mod live;
@@ -19,5 +20,6 @@ pub mod replay;
 pub mod report;
 pub mod schema;
 pub mod writer;
+pub mod ws;
 
 pub use writer::{Recording, RecordingHandle};

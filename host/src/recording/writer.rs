@@ -107,6 +107,7 @@ pub struct Recording {
     last_ns: u64,
     frames: u64,
     executed: BTreeMap<String, Vec<[f64; 2]>>,
+    live: Option<super::ws::FoxgloveServer>,
 }
 
 impl std::fmt::Debug for Recording {
@@ -159,7 +160,29 @@ impl Recording {
             last_ns: 0,
             frames: 0,
             executed: BTreeMap::new(),
+            live: None,
         })
+    }
+
+    /// Also serve every channel live to Foxglove on `addr` (`HOST:PORT`, port 0 picks one):
+    /// every message written from now on is sent to the clients subscribed to its channel.
+    /// Returns the address served.
+    pub fn serve_foxglove(&mut self, addr: &str) -> Result<std::net::SocketAddr> {
+        let chans = channels()
+            .into_iter()
+            .filter_map(|(topic, schema)| {
+                Some(super::ws::Advertised {
+                    id: *self.ids.get(topic)?,
+                    topic: topic.to_string(),
+                    schema_name: schema["title"].as_str().unwrap_or_default().to_string(),
+                    schema,
+                })
+            })
+            .collect();
+        let server = super::ws::FoxgloveServer::start(addr, chans)?;
+        let at = server.addr();
+        self.live = Some(server);
+        Ok(at)
     }
 
     /// The file.
@@ -184,6 +207,9 @@ impl Recording {
             .get(topic)
             .ok_or_else(|| anyhow!("no channel {topic}"))?;
         let data = serde_json::to_vec(msg)?;
+        if let Some(live) = &self.live {
+            live.publish(id, ns, &data);
+        }
         self.seq = self.seq.wrapping_add(1);
         self.last_ns = self.last_ns.max(ns);
         self.writer
