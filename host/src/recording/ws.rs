@@ -154,6 +154,8 @@ fn accept_loop(
     }
 }
 
+// The handshake callback's error type is tungstenite's (an HTTP response), not ours.
+#[allow(clippy::result_large_err)]
 fn serve(stream: TcpStream, rx: &Receiver<Outgoing>, advertise: &str) -> Result<()> {
     stream.set_nonblocking(false)?;
     let mut ws = tungstenite::accept_hdr(stream, |req: &Request, mut resp: Response| {
