@@ -206,9 +206,9 @@ mod tests {
         let page = render("demo", &[a, b], &sizes);
         assert!(page.contains(r#"<h2 id="a">Stage &lt;A&gt;</h2>"#));
         assert!(page.contains(r#"<h2 id="b">"#));
-        // A small figure is shown at twice its size (480 px wide), in proportion.
+        // A small figure is shown larger (here 360 px high), in proportion.
         assert!(
-            page.contains(r#"<img src="a.svg" width="480" height="200""#),
+            page.contains(r#"<img src="a.svg" width="864" height="360""#),
             "{page}"
         );
         assert_eq!(page.matches("class=\"failed\"").count(), 2);
