@@ -99,7 +99,9 @@ pub fn image_annotations(ns: u64, result: &FrameResult, cal: &Calibration) -> Va
             .map(|c| json!({"x": c[0], "y": c[1]}))
             .collect();
         points.push(json!({"timestamp": t, "type": 2, "points": pts,
-                           "outline_color": green, "thickness": 2.0}));
+                           "outline_color": green, "outline_colors": [],
+                           "fill_color": color(0.0, 0.0, 0.0, 0.0), "thickness": 2.0,
+                           "metadata": []}));
     }
     let mut anchors = Vec::new();
     for tr in &result.tracked {
@@ -113,7 +115,7 @@ pub fn image_annotations(ns: u64, result: &FrameResult, cal: &Calibration) -> Va
         };
         circles.push(json!({"timestamp": t, "position": {"x": p[0], "y": p[1]},
                             "diameter": 10.0, "thickness": 2.0,
-                            "fill_color": c, "outline_color": c}));
+                            "fill_color": c, "outline_color": c, "metadata": []}));
         anchors.push((p, tr.body.clone(), c));
     }
     let placed = crate::exec::view::place_labels(
@@ -127,7 +129,8 @@ pub fn image_annotations(ns: u64, result: &FrameResult, cal: &Calibration) -> Va
         texts.push(
             json!({"timestamp": t, "position": {"x": pos[0], "y": pos[1]},
                           "text": text, "font_size": 16.0, "text_color": c,
-                          "background_color": color(0.0, 0.0, 0.0, 0.6)}),
+                          "background_color": color(0.0, 0.0, 0.0, 0.6),
+                          "metadata": []}),
         );
     }
     json!({"circles": circles, "points": points, "texts": texts})
@@ -163,9 +166,11 @@ fn line(kind: u8, pts: &[[f64; 2]], z: f64, width: f64, c: Value) -> Value {
 }
 
 fn entity(ns: u64, frame: &str, id: &str, locked: bool, lines: Vec<Value>) -> Value {
+    // Every primitive list present (empty when unused), as the schema lists them.
     json!({"timestamp": time(ns), "frame_id": frame, "id": id,
            "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": locked, "metadata": [],
-           "lines": lines, "texts": []})
+           "arrows": [], "cubes": [], "spheres": [], "cylinders": [], "lines": lines,
+           "triangles": [], "texts": [], "models": []})
 }
 
 /// `foxglove.SceneUpdate` of a scene: the table's edge and the obstacles in `table`, each

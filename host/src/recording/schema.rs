@@ -135,7 +135,8 @@ pub fn image_annotations() -> Value {
     let circle = obj(
         "foxglove.CircleAnnotation",
         json!({"timestamp": time(), "position": point2(), "diameter": num(),
-               "thickness": num(), "fill_color": color(), "outline_color": color()}),
+               "thickness": num(), "fill_color": color(), "outline_color": color(),
+               "metadata": arr(json!({"type": "object"}))}),
     );
     let points = obj(
         "foxglove.PointsAnnotation",
@@ -187,8 +188,12 @@ pub fn scene_update() -> Value {
     let entity = obj(
         "foxglove.SceneEntity",
         json!({"timestamp": time(), "frame_id": string(), "id": string(),
-               "lifetime": duration(), "frame_locked": boolean(), "metadata": arr(kv),
-               "lines": arr(line), "texts": arr(text)}),
+               "lifetime": duration(), "frame_locked": boolean(), "metadata": arr(kv.clone()),
+               "arrows": arr(json!({"type": "object"})), "cubes": arr(json!({"type": "object"})),
+               "spheres": arr(json!({"type": "object"})),
+               "cylinders": arr(json!({"type": "object"})), "lines": arr(line),
+               "triangles": arr(json!({"type": "object"})), "texts": arr(text),
+               "models": arr(json!({"type": "object"}))}),
     );
     let deletion = obj(
         "foxglove.SceneEntityDeletion",
