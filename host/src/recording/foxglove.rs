@@ -71,15 +71,27 @@ pub fn camera_calibration(ns: u64, cal: &Calibration) -> Value {
     })
 }
 
-/// Focal length from `H = K [r1 r2 t]` with `r1 ⟂ r2` (Zhang's constraint, one view).
+/// Focal length from `H = K [r1 r2 t]`: `r1 ⟂ r2` and `|r1| = |r2|` (Zhang's two constraints,
+/// one view), whichever is better conditioned; `None` when neither says anything (a camera
+/// looking straight down).
 fn focal_length(cal: &Calibration, cx: f64, cy: f64) -> Option<f64> {
     let m = &cal.table_to_pixel.0;
     let col = |j: usize| [m[0][j] - cx * m[2][j], m[1][j] - cy * m[2][j], m[2][j]];
     let (a, b) = (col(0), col(1));
-    if (a[2] * b[2]).abs() < 1e-12 {
+    let orthogonal = (-(a[0] * b[0] + a[1] * b[1]), a[2] * b[2]);
+    let equal = (
+        b[0] * b[0] + b[1] * b[1] - a[0] * a[0] - a[1] * a[1],
+        a[2] * a[2] - b[2] * b[2],
+    );
+    let (n, d) = if orthogonal.1.abs() >= equal.1.abs() {
+        orthogonal
+    } else {
+        equal
+    };
+    if d.abs() < 1e-12 {
         return None;
     }
-    let f2 = -(a[0] * b[0] + a[1] * b[1]) / (a[2] * b[2]);
+    let f2 = n / d;
     (f2.is_finite() && f2 > 1.0).then(|| f2.sqrt())
 }
 
@@ -266,4 +278,88 @@ pub fn path_update(ns: u64, id: &str, pts: &[[f64; 2]], c: Value) -> Value {
 pub fn log(ns: u64, level: u8, name: &str, message: &str) -> Value {
     json!({"timestamp": time(ns), "level": level, "message": message, "name": name,
            "file": "", "line": 0})
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pushbot_world::camera::Homography;
+
+    fn calibration(h: [[f64; 3]; 3]) -> Calibration {
+        Calibration {
+            version: 1,
+            image_size: [960, 720],
+            pixel_to_table: Homography(h),
+            table_to_pixel: Homography(h),
+            rms_px: 0.0,
+            max_px: 0.0,
+            mm_per_px: 1.0,
+            markers: Vec::new(),
+            points: 0,
+        }
+    }
+
+    #[test]
+    fn times_quaternions_and_images() {
+        assert_eq!(time(3_000_000_007), json!({"sec": 3, "nsec": 7}));
+        let q = yaw(std::f64::consts::FRAC_PI_2);
+        assert!((q["z"].as_f64().unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
+        assert!((q["w"].as_f64().unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
+        let png = b"\x89PNG fake bytes \x00\xff";
+        let msg = compressed_image(5, png);
+        assert_eq!(msg["format"], "png");
+        assert_eq!(image_data(&msg).as_deref(), Some(&png[..]));
+        assert_eq!(image_data(&json!({"data": "not base64!"})), None);
+    }
+
+    #[test]
+    fn a_pinhole_is_read_from_the_homography() {
+        // Straight down: no perspective, the focal length falls back to the image width.
+        let down = calibration([[500.0, 0.0, 100.0], [0.0, -500.0, 600.0], [0.0, 0.0, 1.0]]);
+        assert_eq!(camera_calibration(0, &down)["K"][0], 960.0);
+        // H = K [r1 r2 t] of a camera with f = 800 tilted 20° about x, 1.5 m away.
+        let (f, cx, cy) = (800.0, 480.0, 360.0);
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let (r1, r2, t) = ([1.0, 0.0, 0.0], [0.0, c, s], [-0.6, -0.4, 1.5]);
+        let k = |v: [f64; 3]| [f * v[0] + cx * v[2], f * v[1] + cy * v[2], v[2]];
+        let (a, b, tt) = (k(r1), k(r2), k(t));
+        let h = [
+            [a[0], b[0], tt[0]],
+            [a[1], b[1], tt[1]],
+            [a[2], b[2], tt[2]],
+        ];
+        let got = camera_calibration(0, &calibration(h))["K"][0]
+            .as_f64()
+            .unwrap();
+        assert!((got - f).abs() < 1e-6, "{got}");
+    }
+
+    #[test]
+    fn the_scene_has_an_entity_for_everything_on_the_table() {
+        let scene = Scene::preset("lau-obstacles").expect("preset");
+        let u = scene_update(0, &scene);
+        let ids: Vec<&str> = u["entities"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["id"].as_str().unwrap())
+            .collect();
+        let expected = 2 + scene.obstacles.len() + scene.objects.len() + scene.goals.len();
+        assert_eq!(ids.len(), expected, "{ids:?}");
+        assert!(ids.contains(&"table") && ids.contains(&"robot"));
+        // An object's outline is drawn in its own frame, so it follows the tracked pose.
+        let o = &scene.objects[0];
+        let e = u["entities"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["id"] == format!("object-{}", o.id))
+            .unwrap();
+        assert_eq!(e["frame_id"], o.id.as_str());
+        assert_eq!(e["frame_locked"], true);
+        assert_eq!(
+            e["lines"][0]["points"].as_array().unwrap().len(),
+            o.outline.len()
+        );
+    }
 }

@@ -73,3 +73,15 @@ impl LiveRecording {
         });
     }
 }
+
+impl Drop for LiveRecording {
+    /// The robot's reports since the last look (the end of the last motion) are recorded too.
+    fn drop(&mut self) {
+        self.handle.with(|r| {
+            for e in self.events.try_iter() {
+                r.robot_event(&e)?;
+            }
+            r.flush()
+        });
+    }
+}
