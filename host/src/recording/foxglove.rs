@@ -320,18 +320,25 @@ mod tests {
         // H = K [r1 r2 t] of a camera with f = 800 tilted 20° about x, 1.5 m away.
         let (f, cx, cy) = (800.0, 480.0, 360.0);
         let (s, c) = 20f64.to_radians().sin_cos();
-        let (r1, r2, t) = ([1.0, 0.0, 0.0], [0.0, c, s], [-0.6, -0.4, 1.5]);
         let k = |v: [f64; 3]| [f * v[0] + cx * v[2], f * v[1] + cy * v[2], v[2]];
-        let (a, b, tt) = (k(r1), k(r2), k(t));
-        let h = [
-            [a[0], b[0], tt[0]],
-            [a[1], b[1], tt[1]],
-            [a[2], b[2], tt[2]],
-        ];
-        let got = camera_calibration(0, &calibration(h))["K"][0]
-            .as_f64()
-            .unwrap();
-        assert!((got - f).abs() < 1e-6, "{got}");
+        // Then also tilted about y and turned 30° about the optical axis (there the
+        // orthogonality constraint decides).
+        let (sz, cz) = 30f64.to_radians().sin_cos();
+        let turned = |v: [f64; 3]| [cz * v[0] - sz * v[1], sz * v[0] + cz * v[1], v[2]];
+        let tilt_y = |v: [f64; 3]| [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]];
+        let (r1, r2) = ([1.0, 0.0, 0.0], [0.0, c, s]);
+        for (r1, r2) in [(r1, r2), (turned(tilt_y(r1)), turned(tilt_y(r2)))] {
+            let (a, b, tt) = (k(r1), k(r2), k([-0.6, -0.4, 1.5]));
+            let h = [
+                [a[0], b[0], tt[0]],
+                [a[1], b[1], tt[1]],
+                [a[2], b[2], tt[2]],
+            ];
+            let got = camera_calibration(0, &calibration(h))["K"][0]
+                .as_f64()
+                .unwrap();
+            assert!((got - f).abs() < 1e-6, "{got}");
+        }
     }
 
     #[test]
