@@ -94,6 +94,14 @@ fn demo_records_and_replay_reproduces_the_tracked_poses() {
     let page = v["report"].as_str().expect("report");
     let html = std::fs::read_to_string(page).expect("report.html");
     assert!(html.contains("<figure"), "the replay report has figures");
+    // The run drawn from the recording is the live report's figure, but for its title.
+    let live = std::fs::read_to_string(dir.path().join("stable-run.svg")).expect("live figure");
+    let again = std::fs::read_to_string(dir.path().join("replay/session-1-run.svg"))
+        .expect("replayed figure");
+    assert_eq!(
+        live.replace("stable pushes executed open loop (truth)", "T"),
+        again.replace("fig15 as recorded", "T")
+    );
 }
 
 #[test]
