@@ -19,10 +19,17 @@ say "installing what the tests need"
 need_pkgs=()
 command -v qemu-system-arm >/dev/null 2>&1 || need_pkgs+=(qemu-system-arm)
 command -v arm-none-eabi-size >/dev/null 2>&1 || need_pkgs+=(binutils-arm-none-eabi)
+# The report is opened in a real browser, recordings read with Python's mcap (issue 23).
+command -v chromium >/dev/null 2>&1 || need_pkgs+=(chromium)
+python3 -m pip --version >/dev/null 2>&1 || need_pkgs+=(python3-pip)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_pkgs[@]}" >/dev/null
+fi
+if ! python3 -c 'import mcap' 2>/dev/null; then
+  python3 -m pip install --quiet --disable-pip-version-check mcap 2>/dev/null \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages mcap
 fi
 # rust-toolchain.toml names the toolchain, components and targets; make sure they are there.
 rustup show active-toolchain >/dev/null
@@ -62,6 +69,11 @@ fi
 
 say "tests"
 cargo test --workspace
+
+# Recordings (MCAP, Foxglove schemas) read by Python's mcap, replay, a recording cut by
+# SIGKILL, and the report opened in headless chromium (issue 23).
+say "recordings, replay and the report in a browser"
+bash scripts/check-recording.sh
 
 # The firmware ELF itself in QEMU against the real host link (issue 3): the board binary's
 # handshake, heartbeats, stall fault, link watchdog and garbage rejection.

@@ -11,6 +11,7 @@ pub mod link;
 pub mod mechanics;
 pub mod planner;
 pub mod plot;
+pub mod recording;
 pub mod report;
 pub mod robot;
 #[cfg(feature = "sim")]

@@ -344,11 +344,22 @@ fn cli_calibrate_and_track_on_a_folder() {
     let cal = dir.path().join("cal.json");
     let bin = env!("CARGO_BIN_EXE_pushbot");
     let cam = dir.path().to_str().unwrap();
+    // The frames show the test layout, not the scene format's default markers: say so.
+    let other = tempfile::tempdir().unwrap();
+    let layout = other.path().join("layout.json");
+    std::fs::write(
+        &layout,
+        serde_json::to_string(&MarkerLayout::default_table()).unwrap(),
+    )
+    .unwrap();
+    let layout = layout.to_str().unwrap();
     let out = std::process::Command::new(bin)
         .args([
             "calibrate",
             "--camera",
             cam,
+            "--layout",
+            layout,
             "--out",
             cal.to_str().unwrap(),
             "--json",
@@ -367,6 +378,8 @@ fn cli_calibrate_and_track_on_a_folder() {
             "track",
             "--camera",
             cam,
+            "--layout",
+            layout,
             "--calibration",
             cal.to_str().unwrap(),
             "--json",
@@ -421,4 +434,46 @@ fn cli_calibrate_and_track_on_a_folder() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// Without `--scene` or `--layout`, `pushbot calibrate` looks for the markers the README and
+/// the scene format name: calibration tags 40–45 on the bare 1.2 m × 0.9 m table.
+#[test]
+fn calibrate_defaults_to_the_scene_formats_markers() {
+    let scene = pushbot_world::Scene::preset("empty").unwrap();
+    let layout = MarkerLayout::from_scene(&scene);
+    let mut ids: Vec<u32> = layout.calibration.iter().map(|m| m.id).collect();
+    ids.sort_unstable();
+    assert_eq!(ids, vec![40, 41, 42, 43, 44, 45]);
+    let dir = tempfile::tempdir().unwrap();
+    for f in synth::frames(&layout, 2, 3, &SynthParams::default()).unwrap() {
+        let cf = CameraFrame {
+            seq: f.frame.seq,
+            time: f.frame.time,
+            width: f.frame.width,
+            height: f.frame.height,
+            pixels: f.frame.pixels,
+            truth: f.markers,
+        };
+        cf.write_png(dir.path()).unwrap();
+    }
+    let cal = dir.path().join("cal.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pushbot"))
+        .args([
+            "calibrate",
+            "--camera",
+            dir.path().to_str().unwrap(),
+            "--frames",
+            "2",
+        ])
+        .args(["--out", cal.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["markers"], serde_json::json!([40, 41, 42, 43, 44, 45]));
 }

@@ -20,7 +20,11 @@ use pushbot_sim::{Pose, PtySim, Scene, SimOptions};
 
 /// The simulated pushbot robot, served on a pseudo-terminal.
 #[derive(Parser, Debug)]
-#[command(version, about, args_conflicts_with_subcommands = true)]
+#[command(
+    version,
+    about,
+    after_help = "Examples:\n  pushbot-sim --seed 3 --speed 5 --truth-log truth.jsonl\n  pushbot-sim --scene lau-irregular --frames frames/ --no-stdin"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Sub>,
@@ -38,7 +42,9 @@ struct Cli {
     #[arg(long, value_name = "PRESET|FILE")]
     scene: Option<String>,
     /// Seed of all simulated noise: the same seed and the same host bytes give the same run.
-    #[arg(long, default_value_t = 0)]
+    /// Global, like `--json` and `-v`: `pushbot-sim bench --seed 3` is `pushbot-sim --seed 3
+    /// bench`.
+    #[arg(long, default_value_t = 0, global = true)]
     seed: u64,
     /// Simulated seconds per wall-clock second: 1 = real time, 20 = twenty times faster,
     /// 0 = as fast as possible (unpaced; the host must then not rely on wall-clock timing).
@@ -117,6 +123,9 @@ struct FirstLine<'a> {
 enum Sub {
     /// Drive a recorded pusher trajectory against one object of a scene and print the object's
     /// simulated trajectory (quasi-static pushing, no robot dynamics).
+    #[command(
+        after_help = "Example:\n  pushbot-sim replay --scene lynch-mason-fig12 --object slider --pusher pusher.csv --json"
+    )]
     Replay {
         /// Scene: preset name or TOML file.
         #[arg(long, value_name = "PRESET|FILE")]
@@ -130,9 +139,13 @@ enum Sub {
         pusher: PathBuf,
     },
     /// List the built-in scene presets.
+    #[command(after_help = "Example:\n  pushbot-sim presets")]
     Presets,
     /// Measure how fast the in-process simulation runs (robot + firmware + a scene's objects,
     /// the robot driving and pushing), and print one JSON object.
+    #[command(
+        after_help = "Example:\n  pushbot-sim bench --scene three-boxes --seconds 30 --seed 3"
+    )]
     Bench {
         /// Scene: preset name or TOML file.
         #[arg(long, default_value = "three-boxes")]
@@ -163,12 +176,35 @@ macro_rules! bad_input {
     };
 }
 
+/// Parse the command line: the global flags (`-v`, `--json`, `--seed`) go before or after a
+/// subcommand, as for `pushbot`; the simulator's own flags only without a subcommand.
+fn parse_cli() -> Cli {
+    use clap::{CommandFactory, FromArgMatches, parser::ValueSource};
+    let mut cmd = Cli::command();
+    let m = cmd.get_matches_mut();
+    if let Some(sub) = m.subcommand_name() {
+        let stray = cmd.get_arguments().find(|a| {
+            !a.is_global_set()
+                && m.value_source(a.get_id().as_str()) == Some(ValueSource::CommandLine)
+        });
+        if let Some(a) = stray {
+            let name = a.get_long().unwrap_or(a.get_id().as_str()).to_string();
+            cmd.error(
+                clap::error::ErrorKind::ArgumentConflict,
+                format!("--{name} runs the simulator; it cannot be used with `{sub}`"),
+            )
+            .exit();
+        }
+    }
+    Cli::from_arg_matches(&m).unwrap_or_else(|e| e.exit())
+}
+
 fn main() {
     // The Rust runtime ignores SIGPIPE, so `println!` into a closed pipe would panic; with the
     // default back, `pushbot-sim presets | head -1` ends quietly. The camera socket is written
     // with MSG_NOSIGNAL by std and the pty gives EIO, so neither can raise the signal.
     sigpipe::reset();
-    let cli = Cli::parse();
+    let cli = parse_cli();
     init_logging(cli.verbose);
     let json = cli.json;
     let result = match cli.command {
@@ -177,7 +213,7 @@ fn main() {
             ref object,
             ref pusher,
         }) => replay(scene, object, pusher, json),
-        Some(Sub::Bench { ref scene, seconds }) => bench(scene, seconds),
+        Some(Sub::Bench { ref scene, seconds }) => bench(scene, seconds, cli.seed),
         Some(Sub::Presets) => {
             for name in pushbot_sim::scene::PRESETS {
                 println!("{name}");
@@ -421,7 +457,7 @@ fn replay(scene: &str, object: &str, pusher: &std::path::Path, json: bool) -> Re
     Ok(())
 }
 
-fn bench(scene: &str, seconds: f64) -> Result<()> {
+fn bench(scene: &str, seconds: f64, seed: u64) -> Result<()> {
     use pushbot_protocol::{Command, HostFrame, MAX_FRAME, PROTOCOL_VERSION, encode_frame};
     if !(seconds.is_finite() && seconds > 0.0) {
         bad_input!("--seconds must be positive");
@@ -430,6 +466,7 @@ fn bench(scene: &str, seconds: f64) -> Result<()> {
     let objects = scene.objects.len();
     let mut sim = pushbot_sim::Sim::new(&SimOptions {
         scene: Some(scene),
+        seed,
         ..SimOptions::default()
     })?;
     let mut buf = [0u8; MAX_FRAME];

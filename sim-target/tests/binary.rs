@@ -282,3 +282,55 @@ fn unplugging_without_a_link_is_refused() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--link"), "{err}");
 }
+
+/// The global flags (`--seed`, `--json`, `-v`) go before or after a subcommand, as for
+/// `pushbot`, and mean the same; the simulator's own flags are refused with a subcommand.
+#[test]
+fn global_flags_before_or_after_the_subcommand() {
+    let run = |args: &[&str]| {
+        Process::new(env!("CARGO_BIN_EXE_pushbot-sim"))
+            .args(args)
+            .stdin(Stdio::null())
+            .output()
+            .expect("run")
+    };
+    let before = run(&["--seed", "3", "--json", "bench", "--seconds", "1"]);
+    let after = run(&["bench", "--seed", "3", "--json", "--seconds", "1"]);
+    for out in [&before, &after] {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let pose = |out: &std::process::Output| {
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+        v["final_pose"].clone()
+    };
+    assert_eq!(pose(&before), pose(&after));
+    let stray = run(&["--speed", "3", "bench", "--seconds", "1"]);
+    assert_eq!(stray.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&stray.stderr).contains("--speed"));
+}
+
+/// Every `--help` ends with an example that names the binary.
+#[test]
+fn every_help_has_an_example() {
+    for args in [
+        &["--help"][..],
+        &["bench", "--help"],
+        &["replay", "--help"],
+        &["presets", "--help"],
+    ] {
+        let out = Process::new(env!("CARGO_BIN_EXE_pushbot-sim"))
+            .args(args)
+            .output()
+            .expect("run");
+        let text = String::from_utf8_lossy(&out.stdout);
+        let (_, ex) = text
+            .split_once("\nExample:\n")
+            .or_else(|| text.split_once("\nExamples:\n"))
+            .unwrap_or_else(|| panic!("{args:?}: no example in {text}"));
+        assert!(ex.trim_start().starts_with("pushbot-sim"), "{args:?}: {ex}");
+    }
+}

@@ -28,6 +28,8 @@ fn the_stable_stage_runs_and_writes_the_report() {
         assert!(page.contains(f), "report.html does not show {f}");
     }
     assert!(out.join("demo.log").exists());
+    // The run is recorded by default (see host/tests/recording.rs for what it holds).
+    assert!(out.join("run.mcap").metadata().expect("run.mcap").len() > 0);
     // The live view was kept: the last camera frame and its overlay.
     assert!(out.join("live/camera.png").exists());
     let overlay = std::fs::read_to_string(out.join("live/overlay.svg")).expect("overlay");

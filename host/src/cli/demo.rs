@@ -30,7 +30,7 @@ pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
 /// `pushbot demo`.
 #[derive(Args, Debug, Clone)]
 #[command(
-    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml --reconnect 10\n  pushbot demo --stages strategy --faults --fault-cut-every 5 --fault-cut-for 1"
+    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --stages stable --foxglove 127.0.0.1:8765\n  pushbot demo --stages strategy --faults --fault-cut-every 5 --fault-cut-for 1\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml --reconnect 10 --intrinsics camera.yaml"
 )]
 pub struct DemoArgs {
     /// Folder for the report (created; files in it are replaced).
@@ -72,6 +72,18 @@ pub struct DemoArgs {
     #[cfg(feature = "sim")]
     #[command(flatten)]
     pub faults: crate::sim::target::FaultArgs,
+    /// Record the run into this MCAP file (default OUT/run.mcap): camera, detections, tracked
+    /// poses, scene, paths, telemetry, logs, in Foxglove's schemas (open it in Foxglove, or
+    /// `pushbot replay FILE`).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// Do not record the run.
+    #[arg(long, conflicts_with = "record")]
+    pub no_record: bool,
+    /// Serve the recording's channels live over the Foxglove WebSocket protocol while the run
+    /// goes (open Foxglove, "Open connection", ws://ADDR); ADDR defaults to 127.0.0.1:8765.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765", conflicts_with = "no_record")]
+    pub foxglove: Option<String>,
 }
 
 /// The scene a stage runs on: `--scene STAGE=…` or the default.
@@ -171,8 +183,17 @@ fn run_stages(
         link: g.link_options()?,
         recover: !g.no_recover,
         lens: g.lens()?,
+        foxglove: args.foxglove.clone(),
+        record: (!args.no_record).then(|| {
+            args.record
+                .clone()
+                .unwrap_or_else(|| args.out.join("run.mcap"))
+        }),
     };
     let t0 = Instant::now();
+    if let Some(addr) = args.foxglove.as_ref().filter(|_| !g.json) {
+        println!("Foxglove live view: open a connection to ws://{addr}");
+    }
     if args.view && !g.json {
         println!(
             "live view: open {} in a browser",
@@ -187,6 +208,7 @@ fn run_stages(
             "success": ok,
             "wall_s": t0.elapsed().as_secs_f64(),
             "stages": report.stages(),
+            "recording": opts.record,
         });
         println!("{v}");
     } else {
@@ -199,6 +221,9 @@ fn run_stages(
             );
         }
         println!("report: {}", page.display());
+        if let Some(r) = &opts.record {
+            println!("recording: {}", r.display());
+        }
     }
     Ok(if ok {
         Status::Success

@@ -79,29 +79,50 @@ pub fn run(g: &Global, a: &BenchLinkArgs) -> CliResult {
         return Ok(Status::Success);
     }
     let share = |n: usize| 100.0 * n as f64 / r.sent.max(1) as f64;
-    println!("| link bench (seed {}) | value |", g.seed);
-    println!("|---|---|");
-    println!("| sent | {} |", r.sent);
-    println!(
-        "| completed | {} ({:.2} %) |",
-        r.completed,
-        share(r.completed)
-    );
-    println!("| refused | {} |", r.refused);
-    println!("| failed (motion ended otherwise) | {} |", r.failed);
-    println!("| unknown | {} |", r.unknown);
-    println!("| motions the robot started | {} |", r.motions_started);
-    println!("| executed twice | {} |", r.executed_twice);
-    println!("| motions nobody asked for | {} |", r.unasked_motions);
-    println!("| watchdog trips | {} |", r.watchdog_trips);
-    println!("| recoveries | {} |", r.recoveries);
-    println!("| retries per command | {:.3} |", r.retries_per_command);
-    println!(
-        "| latency p50 / p99 (robot time) | {:.1} / {:.1} ms |",
-        r.latency_ms.p50, r.latency_ms.p99
-    );
-    println!("| robot time | {:.1} s |", r.robot_time_s);
-    println!("| wall time | {:.1} s |", r.wall_s);
+    let rows: Vec<(&str, String)> = vec![
+        ("sent", r.sent.to_string()),
+        (
+            "completed",
+            format!("{} ({:.2} %)", r.completed, share(r.completed)),
+        ),
+        ("refused", r.refused.to_string()),
+        ("failed (motion ended otherwise)", r.failed.to_string()),
+        ("unknown", r.unknown.to_string()),
+        ("motions the robot started", r.motions_started.to_string()),
+        ("executed twice", r.executed_twice.to_string()),
+        ("motions nobody asked for", r.unasked_motions.to_string()),
+        ("watchdog trips", r.watchdog_trips.to_string()),
+        ("recoveries", r.recoveries.to_string()),
+        (
+            "retries per command",
+            format!("{:.3}", r.retries_per_command),
+        ),
+        (
+            "latency p50 / p99 (robot time)",
+            format!("{:.1} / {:.1} ms", r.latency_ms.p50, r.latency_ms.p99),
+        ),
+        ("robot time", format!("{:.1} s", r.robot_time_s)),
+        ("wall time", format!("{:.1} s", r.wall_s)),
+    ];
+    let head = format!("link bench (seed {})", g.seed);
+    let w = rows
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .chain([head.chars().count()])
+        .max()
+        .unwrap_or(0);
+    let v = rows
+        .iter()
+        .map(|(_, v)| v.chars().count())
+        .chain([5])
+        .max()
+        .unwrap_or(0);
+    // A Markdown table whose columns line up in a terminal too.
+    println!("| {head:<w$} | {:<v$} |", "value");
+    println!("|{}|{}|", "-".repeat(w + 2), "-".repeat(v + 2));
+    for (k, val) in &rows {
+        println!("| {k:<w$} | {val:>v$} |");
+    }
     Ok(Status::Success)
 }
 

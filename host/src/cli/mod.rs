@@ -13,6 +13,7 @@ use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 pub mod demo;
 pub mod link_bench;
 pub mod rearrange;
+pub mod replay;
 pub mod robot;
 pub mod scene;
 pub mod stable;
@@ -106,6 +107,8 @@ pub enum Command {
     Calibrate(vision::CalibrateArgs),
     /// Track the robot, objects and goals with the overhead camera (one line per frame).
     Track(vision::TrackArgs),
+    /// Re-run tracking from a recording (`--record`, the demo's run.mcap) and write its report.
+    Replay(replay::ReplayArgs),
     /// Measure planners and pipelines; prints numbers.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -235,6 +238,7 @@ pub const EXAMPLES: &[(&str, &str)] = &[
         "track",
         "pushbot track --camera sim:127.0.0.1:5600 --scene lau-irregular --frames 100 --json",
     ),
+    ("replay", "pushbot replay pushbot-demo/run.mcap --json"),
     ("bench", "pushbot bench stable --repeat 3"),
     ("bench rearrange", "pushbot bench rearrange --quick"),
     ("bench stable", "pushbot bench stable --repeat 3 --json"),
@@ -368,6 +372,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Bench(BenchCommand::Link(a)) => link_bench::run(&global, &a),
         Command::Calibrate(a) => vision::calibrate(&global, a),
         Command::Track(a) => vision::track(&global, a),
+        Command::Replay(a) => replay::run(&global, a),
         Command::Bench(BenchCommand::Vision(b)) => vision::bench(&global, b),
         Command::Bench(BenchCommand::Strategy(cmd)) => {
             strategy::run_bench(&global, strategy_args::BenchArgs { cmd })

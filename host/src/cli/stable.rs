@@ -289,11 +289,12 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
             println!(
                 "{:<8} {:>6} {:>6} {:>8} {:>12.2} {:>8}",
                 r["preset"].as_str().unwrap_or(""),
-                r["found"],
-                r["cost"],
-                r["nodes_expanded"],
+                // A JSON value ignores width and alignment: print it as a string first.
+                r["found"].to_string(),
+                r["cost"].to_string(),
+                r["nodes_expanded"].to_string(),
                 r["plan_time_ms"].as_f64().unwrap_or(0.0),
-                r["paper_s"]
+                r["paper_s"].to_string()
             );
         }
     }

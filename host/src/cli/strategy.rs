@@ -82,6 +82,12 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
             "the boundary inset must be finite and not negative",
         ));
     }
+    let recording = match &a.record {
+        Some(p) => Some(crate::recording::RecordingHandle::new(
+            crate::recording::Recording::create(p).map_err(CliError::BadInput)?,
+        )),
+        None => None,
+    };
     let opts = LiveOptions {
         boundary_inset,
         object: a.object.clone(),
@@ -89,6 +95,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
         link: global.link_options()?,
         recover: !global.no_recover,
         lens: global.lens()?,
+        recording: recording.clone(),
         ..LiveOptions::default()
     };
     let mut io = LiveRobot::connect(port, camera, scene, opts).map_err(CliError::Failed)?;
@@ -189,6 +196,9 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
         runs.push(d);
     }
     let res = summarise("live", method, &runs);
+    if let Some(h) = &recording {
+        h.finish()?;
+    }
     if global.json {
         println!(
             "{}",

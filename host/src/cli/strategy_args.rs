@@ -159,6 +159,10 @@ pub struct DeliveryArgs {
     /// With `--hil`: the robot's link watchdog, ms of robot time.
     #[arg(long, default_value_t = 1000)]
     pub watchdog_ms: u16,
+    /// With `--hil`: record the run (camera, detections, tracked poses, telemetry) into this
+    /// MCAP file, in Foxglove's schemas (`pushbot replay FILE` tracks it again).
+    #[arg(long, value_name = "FILE.mcap", requires = "hil")]
+    pub record: Option<PathBuf>,
     /// Collection's evaluation stops after this many straight successful queries (0: initial
     /// collection only).
     #[arg(long, default_value_t = 10)]

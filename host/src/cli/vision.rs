@@ -25,7 +25,9 @@ pub struct CameraArgs {
     #[arg(long, value_name = "PRESET|FILE", conflicts_with = "layout")]
     pub scene: Option<String>,
     /// A stand-alone marker layout instead of a scene (TOML or JSON: table, calibration
-    /// markers, body markers); default: the built-in 1.2 × 0.9 m table.
+    /// markers, body markers); default: the markers the scene format names on its bare
+    /// 1.2 × 0.9 m table (the `empty` preset): calibration tags 40–45 6 cm in from the corners
+    /// and the middles of the long edges, the robot's tag 0.
     #[arg(long)]
     pub layout: Option<PathBuf>,
     /// Frame rate assumed for image folders without time sidecars.
@@ -67,6 +69,10 @@ pub struct TrackArgs {
     /// (whole frames then come only every 15 frames and whenever a body is missed).
     #[arg(long)]
     pub whole_frames: bool,
+    /// Record the frames, detections and tracked poses into this MCAP file (Foxglove schemas;
+    /// `pushbot replay FILE` tracks them again).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
 }
 
 /// `pushbot bench …`.
@@ -89,7 +95,9 @@ fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
     }
     match &args.layout {
         Some(p) => MarkerLayout::load(p).map_err(CliError::bad_input),
-        None => Ok(MarkerLayout::default_table()),
+        None => pushbot_world::Scene::preset("empty")
+            .map(|s| MarkerLayout::from_scene(&s))
+            .map_err(|e| CliError::Failed(anyhow::anyhow!("the empty preset: {e}"))),
     }
 }
 
@@ -189,6 +197,31 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     } else {
         RoiParams::default()
     };
+    let recording = match &args.record {
+        Some(path) => {
+            let mut rec = crate::recording::Recording::create(path).map_err(CliError::BadInput)?;
+            let scene = match &args.camera.scene {
+                Some(s) => Some(
+                    pushbot_world::Scene::preset_or_file(s)
+                        .map_err(|e| CliError::bad_input(e.to_string()))?,
+                ),
+                None => None,
+            };
+            let info = crate::recording::writer::SessionInfo {
+                label: "track",
+                scene: scene.as_ref(),
+                layout: &lay,
+                calibration: &cal,
+                tracker: TrackerParams::default(),
+                detector: args.camera.detector,
+                whole_frames: args.whole_frames,
+            };
+            rec.begin_session(&info, 0)?;
+            Some(rec)
+        }
+        None => None,
+    };
+    let mut recording = recording;
     let mut pipe = Pipeline::new(det, lay, cal, TrackerParams::default()).with_roi(roi);
     let mut out = std::io::stdout().lock();
     let mut count = 0;
@@ -199,6 +232,11 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
         let r = pipe
             .process(&frame)
             .map_err(|e| CliError::Failed(e.into()))?;
+        if let Some(rec) = recording.as_mut() {
+            // No robot here: the camera's clock is the time line.
+            let us = (frame.time.max(0.0) * 1e6) as u64;
+            rec.frame(us, &frame, &r, pipe.calibration())?;
+        }
         let line = TrackLine::from(&r);
         let text = if g.json {
             serde_json::to_string(&line).map_err(|e| CliError::Failed(e.into()))?
@@ -222,6 +260,9 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
             break;
         }
         count += 1;
+    }
+    if let Some(rec) = recording {
+        rec.finish()?;
     }
     Ok(Status::Success)
 }

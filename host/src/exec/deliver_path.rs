@@ -58,8 +58,10 @@ pub fn deliver_among_obstacles(
             all.failure = Some(Failure::NoPath);
             break;
         };
+        let shown: Vec<[f64; 2]> = path.iter().map(|v| [v.x, v.y]).collect();
+        io.show_path(&shown);
         if first_path.is_empty() {
-            first_path = path.iter().map(|v| [v.x, v.y]).collect();
+            first_path = shown;
         }
         let length: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
         let last = length <= op.subgoal_spacing * 1.5;

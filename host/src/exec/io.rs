@@ -30,4 +30,7 @@ pub trait RobotIo {
     fn time(&self) -> f64;
     /// The workspace.
     fn workspace(&self) -> Workspace;
+    /// The path the robot is working along (table metres), for views and recordings; a robot
+    /// that shows nothing ignores it.
+    fn show_path(&mut self, _path: &[[f64; 2]]) {}
 }

@@ -68,6 +68,8 @@ pub struct LiveOptions {
     /// The camera's lens (`--intrinsics FILE`); `None`: the scene's `camera.intrinsics`, if
     /// any, else an ideal pinhole.
     pub lens: Option<pushbot_world::lens::Intrinsics>,
+    /// Record every look, the robot's telemetry and events into this MCAP recording.
+    pub recording: Option<crate::recording::RecordingHandle>,
 }
 
 impl Default for LiveOptions {
@@ -87,6 +89,7 @@ impl Default for LiveOptions {
             link: LinkOptions::default(),
             recover: true,
             lens: None,
+            recording: None,
         }
     }
 }
@@ -117,6 +120,7 @@ pub struct LiveRobot {
     view: Option<super::view::LiveView>,
     /// Recoveries since the last motion that ran to its end.
     recoveries_in_a_row: usize,
+    recording: Option<crate::recording::live::LiveRecording>,
 }
 
 impl std::fmt::Debug for LiveRobot {
@@ -189,6 +193,18 @@ impl LiveRobot {
             restart_after: 1,
             ..TrackerParams::default()
         };
+        let recording = opts.recording.as_ref().map(|h| {
+            let d = opts.detector;
+            crate::recording::live::LiveRecording::start(
+                h,
+                &robot,
+                scene,
+                &layout,
+                &calibration,
+                params,
+                d,
+            )
+        });
         let pipeline = Pipeline::new(detector, layout, calibration, params);
         let pipeline = match lens {
             Some(l) => pipeline.with_lens(l),
@@ -214,6 +230,7 @@ impl LiveRobot {
             frames_seen: 0,
             view,
             recoveries_in_a_row: 0,
+            recording,
             opts,
         };
         live.look()?;
@@ -279,6 +296,9 @@ impl LiveRobot {
                 && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
             {
                 tracing::warn!("live view: {e:#}");
+            }
+            if let Some(rec) = &self.recording {
+                rec.look(&self.robot, &frame, &r, self.pipeline.calibration());
             }
             for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
                 let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
@@ -525,5 +545,11 @@ impl RobotIo for LiveRobot {
 
     fn workspace(&self) -> Workspace {
         self.workspace
+    }
+
+    fn show_path(&mut self, path: &[[f64; 2]]) {
+        if let Some(v) = self.view.as_mut() {
+            v.plan = path.to_vec();
+        }
     }
 }

@@ -6,6 +6,7 @@ use anyhow::Result;
 use serde::Serialize;
 
 use crate::exec::io::{RobotIo, Workspace};
+use crate::recording::RecordingHandle;
 use crate::strategy::sample::Pose2;
 
 /// One recorded instant: after a primitive (or at the start).
@@ -35,6 +36,7 @@ pub struct Recorder<'a> {
     trace: Vec<TracePoint>,
     primitives: usize,
     driven: f64,
+    recording: Option<RecordingHandle>,
 }
 
 impl<'a> Recorder<'a> {
@@ -48,9 +50,22 @@ impl<'a> Recorder<'a> {
             trace: Vec::new(),
             primitives: 0,
             driven: 0.0,
+            recording: None,
         };
         r.mark("start");
         r
+    }
+
+    /// Also write every trace point (those so far, then each new one) and every path shown
+    /// into `recording`.
+    pub fn with_recording(mut self, recording: Option<RecordingHandle>) -> Self {
+        if let Some(h) = &recording {
+            for p in &self.trace {
+                h.with(|r| r.trace(p));
+            }
+        }
+        self.recording = recording;
+        self
     }
 
     /// Record the present as a point of the trace.
@@ -62,13 +77,17 @@ impl<'a> Recorder<'a> {
             .filter_map(|id| self.inner.body_pose(id).map(|p| (id.clone(), p)))
             .collect();
         let truth = self.truth.as_ref().map(|f| f());
-        self.trace.push(TracePoint {
+        let point = TracePoint {
             t: self.inner.time(),
             after,
             robot,
             objects,
             truth,
-        });
+        };
+        if let Some(h) = &self.recording {
+            h.with(|r| r.trace(&point));
+        }
+        self.trace.push(point);
     }
 
     /// The trace so far.
@@ -144,6 +163,13 @@ impl RobotIo for Recorder<'_> {
 
     fn workspace(&self) -> Workspace {
         self.inner.workspace()
+    }
+
+    fn show_path(&mut self, path: &[[f64; 2]]) {
+        if let Some(h) = &self.recording {
+            h.with(|r| r.planned_path(path));
+        }
+        self.inner.show_path(path);
     }
 }
 

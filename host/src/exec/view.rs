@@ -92,6 +92,7 @@ pub fn overlay_svg(
         let pts: Vec<[f64; 2]> = plan.iter().filter_map(|p| px(p[0], p[1])).collect();
         d.polyline(&pts, &Style::outline("orange", 3.0).dash("8,6"));
     }
+    let mut marks = Vec::new();
     for t in &result.tracked {
         let (Some(a), Some(b)) = (
             px(t.pose.x, t.pose.y),
@@ -112,11 +113,25 @@ pub fn overlay_svg(
             t.pose.y,
             t.pose.theta.to_degrees()
         );
-        d.text(
-            [a[0] + 8.0, a[1] - 8.0],
-            &label,
-            &Style::new().fill(colour).font_size(16.0),
-        );
+        marks.push((a, label, colour));
+    }
+    let spots = place_labels(
+        &marks
+            .iter()
+            .map(|(a, l, _)| (*a, l.chars().count()))
+            .collect::<Vec<_>>(),
+        LABEL_FONT,
+    );
+    for ((a, label, colour), at) in marks.iter().zip(spots) {
+        // A leader line from the body to a label moved away from it.
+        if (at[0] - a[0]).abs() > 12.0 || (at[1] - a[1]).abs() > 2.0 * LABEL_FONT {
+            d.line(
+                *a,
+                [at[0], at[1] - LABEL_FONT * 0.4],
+                &Style::new().stroke(colour).width(1.0),
+            );
+        }
+        d.text(at, label, &Style::new().fill(colour).font_size(LABEL_FONT));
     }
     d.caption(
         &format!("t = {:.2} s, frame {}", result.time, result.seq),
@@ -124,4 +139,73 @@ pub fn overlay_svg(
         &Style::new().fill("yellow"),
     );
     d.to_string()
+}
+
+/// Font size of the live view's labels, pixels.
+const LABEL_FONT: f64 = 16.0;
+
+/// Where to put each label so that none overlaps another: `anchors` are the labelled points
+/// (pixels) with the label's length in characters; returns each label's text origin (left end
+/// of its baseline). A label goes to the first free spot of a few around its point (up-right,
+/// down-right, up-left, down-left), then further down in steps of a line until it is free.
+/// Pure: used by the live page and the recording's image annotations.
+pub fn place_labels(anchors: &[([f64; 2], usize)], font: f64) -> Vec<[f64; 2]> {
+    let h = font * 1.25;
+    let mut boxes: Vec<[f64; 4]> = Vec::new();
+    let mut out = Vec::with_capacity(anchors.len());
+    let overlaps = |b: &[f64; 4], boxes: &[[f64; 4]]| {
+        boxes
+            .iter()
+            .any(|o| b[0] < o[2] && o[0] < b[2] && b[1] < o[3] && o[1] < b[3])
+    };
+    for &(p, chars) in anchors {
+        let w = font * 0.6 * chars as f64;
+        let candidates = [
+            [p[0] + 8.0, p[1] - 8.0],
+            [p[0] + 8.0, p[1] + 8.0 + h],
+            [p[0] - 8.0 - w, p[1] - 8.0],
+            [p[0] - 8.0 - w, p[1] + 8.0 + h],
+        ];
+        let bx = |o: [f64; 2]| [o[0], o[1] - font, o[0] + w, o[1] - font + h];
+        let spot = candidates
+            .iter()
+            .copied()
+            .find(|&o| !overlaps(&bx(o), &boxes))
+            .unwrap_or_else(|| {
+                let mut o = candidates[1];
+                while overlaps(&bx(o), &boxes) {
+                    o[1] += h;
+                }
+                o
+            });
+        boxes.push(bx(spot));
+        out.push(spot);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::place_labels;
+
+    #[test]
+    fn labels_of_close_bodies_do_not_overlap() {
+        // Four bodies within a few pixels of each other, long labels.
+        let anchors: Vec<([f64; 2], usize)> = (0..4)
+            .map(|i| ([100.0 + 3.0 * f64::from(i), 100.0 + 2.0 * f64::from(i)], 30))
+            .collect();
+        let spots = place_labels(&anchors, 16.0);
+        let w = 16.0 * 0.6 * 30.0;
+        let h = 16.0 * 1.25;
+        for i in 0..spots.len() {
+            for j in 0..i {
+                let (a, b) = (spots[i], spots[j]);
+                let apart = (a[0] - b[0]).abs() >= w - 1e-9 || (a[1] - b[1]).abs() >= h - 1e-9;
+                assert!(apart, "labels {i} and {j} overlap: {a:?} {b:?}");
+            }
+        }
+        // A lone label stays next to its point.
+        let one = place_labels(&[([50.0, 60.0], 5)], 16.0);
+        assert_eq!(one, vec![[58.0, 52.0]]);
+    }
 }

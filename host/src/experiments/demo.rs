@@ -64,6 +64,10 @@ pub struct DemoOptions {
     pub recover: bool,
     /// The camera's lens (`--intrinsics`); `None`: each stage scene's own, if any.
     pub lens: Option<pushbot_world::lens::Intrinsics>,
+    /// Record the run into this MCAP file (Foxglove schemas; see [`crate::recording`]).
+    pub record: Option<PathBuf>,
+    /// Serve the recording's channels live to Foxglove on this address (`HOST:PORT`).
+    pub foxglove: Option<String>,
 }
 
 /// Run the demo's stages into a report; a stage that fails is recorded as failed and the next
@@ -72,11 +76,23 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
     let report = Report::create(&opts.out, "pushbot demo", opts.png)?;
     let log = std::fs::File::create(opts.out.join("demo.log"))
         .map_err(|e| anyhow!("creating demo.log: {e}"))?;
+    let recording = match &opts.record {
+        Some(path) => {
+            let mut rec = crate::recording::Recording::create(path)?;
+            if let Some(addr) = &opts.foxglove {
+                let at = rec.serve_foxglove(addr)?;
+                tracing::info!("Foxglove live view: connect to ws://{at}");
+            }
+            Some(crate::recording::RecordingHandle::new(rec))
+        }
+        None => None,
+    };
     let mut ctx = Ctx {
         opts,
         report,
         log,
         recoveries: Vec::new(),
+        recording,
     };
     for stage in &opts.stages {
         let started = std::time::Instant::now();
@@ -111,6 +127,9 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
         ctx.report.add(rep);
     }
     let page = ctx.report.write()?;
+    if let Some(h) = &ctx.recording {
+        h.finish()?;
+    }
     Ok((ctx.report, page))
 }
 
@@ -137,11 +156,15 @@ struct Ctx<'a> {
     log: std::fs::File,
     /// Recoveries of the link during the stage running.
     recoveries: Vec<Recovery>,
+    recording: Option<crate::recording::RecordingHandle>,
 }
 
 impl Ctx<'_> {
     fn log(&mut self, line: &str) {
         let _ = writeln!(self.log, "{line}");
+        if let Some(h) = &self.recording {
+            h.with(|r| r.log(2, "demo", line));
+        }
         tracing::info!("{line}");
     }
 
@@ -187,12 +210,14 @@ impl Ctx<'_> {
             link: self.opts.link.clone(),
             recover: self.opts.recover,
             lens: self.opts.lens,
+            recording: self.recording.clone(),
             ..LiveOptions::default()
         };
         match &self.opts.robot {
             Some((port, camera)) => {
                 let mut live = LiveRobot::connect(port, camera, scene, opts)?;
-                let mut rec = Recorder::new(&mut live, ids, None);
+                let mut rec =
+                    Recorder::new(&mut live, ids, None).with_recording(self.recording.clone());
                 let out = f(&mut rec);
                 let trace = rec.into_trace();
                 self.recoveries.extend(live.recoveries());
@@ -223,7 +248,8 @@ impl Ctx<'_> {
                             .collect();
                         (Pose2::new(t.x, t.y, t.theta), objects)
                     });
-                    let mut rec = Recorder::new(&mut live, ids, Some(probe));
+                    let mut rec = Recorder::new(&mut live, ids, Some(probe))
+                        .with_recording(self.recording.clone());
                     let out = f(&mut rec);
                     let trace = rec.into_trace();
                     self.recoveries.extend(live.recoveries());
@@ -383,7 +409,7 @@ fn stage_rearrange(
 ) -> Result<StageReport> {
     use crate::exec::rearrange::{ExecOptions, execute};
     use crate::planner::rearrange::to_scene::{SceneOptions, scene_for};
-    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg};
+    use crate::planner::rearrange::{Model, cost_map, restore, svg::plan_svg_in};
 
     let mut st = StageReport::new(
         "rearrange",
@@ -402,11 +428,16 @@ fn stage_rearrange(
     let plan = restore(&model, &map, start).map_err(|e| anyhow!("{e}"))?;
     st.number("plan_cost", plan.cost);
     st.number("plan_steps", plan.steps.len());
-    let f = ctx
-        .report
-        .figure("rearrange-plan", &plan_svg(&model, &plan))?;
-    st.figures
-        .push((f, format!("The optimal plan of {case}, step by step")));
+    let f = ctx.report.figure(
+        "rearrange-plan",
+        &plan_svg_in(&model, &plan, Some(SceneOptions::default().cell)),
+    )?;
+    st.figures.push((
+        f,
+        format!(
+            "The optimal plan of {case}, step by step (Figs. 9–19 style): robot blue, boxes where each stage leaves them, goals dashed; axes in metres"
+        ),
+    ));
     let scene_opts = SceneOptions::default();
     let scene = scene_for(problem, &scene_opts)?;
     let ids: Vec<String> = scene.objects.iter().map(|o| o.id.clone()).collect();

@@ -1,9 +1,89 @@
 //! `report.html`: one self-contained page per run — a section per stage with its outcome, its
-//! numbers as a table, its figures and its notes.
+//! numbers as a table (a number that is itself a record, like a collection's statistics, as a
+//! table inside the cell, never raw JSON), its figures at their own size (scaled down only to
+//! fit the page, and up when they are small) with captions, and its notes.
 
+use std::collections::HashMap;
 use std::fmt::Write;
 
+use serde_json::Value;
+
 use super::StageReport;
+
+/// Figures narrower than this are shown scaled up to it, pixels.
+const MIN_FIGURE_PX: f64 = 480.0;
+/// Figures lower than this are shown scaled up to it (a row of small plan panels), pixels;
+/// the page's width caps both.
+const MIN_FIGURE_HEIGHT_PX: f64 = 360.0;
+
+/// A value for a table cell, as HTML: numbers rounded, records as tables, lists of records as
+/// tables with a column per key, other lists comma-separated.
+pub fn value_html(v: &Value) -> String {
+    match v {
+        Value::Number(n) => match n.as_f64() {
+            Some(x) if n.is_f64() => escape(&format!("{x:.4}")),
+            _ => n.to_string(),
+        },
+        Value::String(t) => escape(t),
+        Value::Bool(b) => b.to_string(),
+        Value::Null => "—".into(),
+        Value::Object(m) => {
+            let mut h = String::from("<table class=\"inner\">");
+            for (k, v) in m {
+                let _ = write!(
+                    h,
+                    "<tr><th>{}</th><td>{}</td></tr>",
+                    escape(k),
+                    value_html(v)
+                );
+            }
+            h.push_str("</table>");
+            h
+        }
+        Value::Array(a) if !a.is_empty() && a.iter().all(Value::is_object) => {
+            let mut keys: Vec<&String> = Vec::new();
+            for e in a {
+                for k in e.as_object().into_iter().flat_map(|m| m.keys()) {
+                    if !keys.contains(&k) {
+                        keys.push(k);
+                    }
+                }
+            }
+            let mut h = String::from("<table class=\"inner\"><tr>");
+            for k in &keys {
+                let _ = write!(h, "<th>{}</th>", escape(k));
+            }
+            h.push_str("</tr>");
+            for e in a {
+                h.push_str("<tr>");
+                for k in &keys {
+                    let _ = write!(
+                        h,
+                        "<td>{}</td>",
+                        e.get(k.as_str()).map_or(String::new(), value_html)
+                    );
+                }
+                h.push_str("</tr>");
+            }
+            h.push_str("</table>");
+            h
+        }
+        Value::Array(a) => a.iter().map(value_html).collect::<Vec<_>>().join(", "),
+    }
+}
+
+/// The width and height an SVG declares (its root's `width` and `height`), pixels.
+pub fn svg_size(svg: &str) -> Option<[f64; 2]> {
+    let start = svg.find("<svg")?;
+    let head = &svg[start..start + svg[start..].find('>')?];
+    let attr = |name: &str| -> Option<f64> {
+        let key = format!(" {name}=\"");
+        let i = head.find(&key)? + key.len();
+        let j = head[i..].find('"')?;
+        head[i..i + j].trim_end_matches("px").parse().ok()
+    };
+    Some([attr("width")?, attr("height")?])
+}
 
 /// Escape text for HTML.
 pub fn escape(s: &str) -> String {
@@ -13,8 +93,9 @@ pub fn escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// The page.
-pub fn render(title: &str, stages: &[StageReport]) -> String {
+/// The page; `sizes` are the figures' own sizes by file name (those missing are shown at
+/// the page's width).
+pub fn render(title: &str, stages: &[StageReport], sizes: &HashMap<String, [f64; 2]>) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
@@ -25,10 +106,11 @@ body {{ font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto;
 h1 {{ font-size: 1.6em; }} h2 {{ border-bottom: 1px solid #ccc; padding-bottom: .2em; }}
 .ok {{ color: #18794e; font-weight: bold; }} .failed {{ color: #c0362c; font-weight: bold; }}
 table {{ border-collapse: collapse; margin: .5em 0; }}
-td, th {{ border: 1px solid #ddd; padding: .25em .6em; text-align: left; }}
-figure {{ display: inline-block; margin: .5em; vertical-align: top; }}
-figure img {{ max-width: 520px; border: 1px solid #ddd; }}
-figcaption {{ font-size: .9em; color: #555; max-width: 520px; }}
+td, th {{ border: 1px solid #ddd; padding: .25em .6em; text-align: left; vertical-align: top; }}
+table.inner {{ margin: 0; font-size: .92em; }} table.inner th {{ font-weight: normal; color: #555; }}
+figure {{ display: block; margin: 1em 0; }}
+figure img {{ display: block; max-width: 100%; height: auto; border: 1px solid #ddd; }}
+figcaption {{ font-size: .9em; color: #555; margin-top: .3em; }}
 </style></head><body>
 <h1>{t}</h1>
 <table><tr><th>stage</th><th>paper</th><th>result</th><th>wall s</th><th>mission s</th></tr>
@@ -66,22 +148,28 @@ figcaption {{ font-size: .9em; color: #555; max-width: 520px; }}
         if !s.numbers.is_empty() {
             h.push_str("<table>\n");
             for (k, v) in &s.numbers {
-                let v = match v {
-                    serde_json::Value::Number(n) => match n.as_f64() {
-                        Some(x) if n.is_f64() => format!("{x:.4}"),
-                        _ => n.to_string(),
-                    },
-                    serde_json::Value::String(t) => t.clone(),
-                    other => other.to_string(),
-                };
-                let _ = writeln!(h, "<tr><th>{}</th><td>{}</td></tr>", escape(k), escape(&v));
+                let _ = writeln!(
+                    h,
+                    "<tr><th>{}</th><td>{}</td></tr>",
+                    escape(k),
+                    value_html(v)
+                );
             }
             h.push_str("</table>\n");
         }
         for (file, caption) in &s.figures {
+            // The figure's own size, scaled up when small so its text stays readable; CSS
+            // scales it down to the page's width.
+            let size = match sizes.get(file) {
+                Some(&[w, hh]) if w > 0.0 && hh > 0.0 => {
+                    let k = (MIN_FIGURE_PX / w).max(MIN_FIGURE_HEIGHT_PX / hh).max(1.0);
+                    format!(r#" width="{:.0}" height="{:.0}""#, w * k, hh * k)
+                }
+                _ => r#" style="width: 100%""#.to_string(),
+            };
             let _ = writeln!(
                 h,
-                r#"<figure><a href="{f}"><img src="{f}" alt="{c}"></a><figcaption>{c}</figcaption></figure>"#,
+                r#"<figure><a href="{f}"><img src="{f}"{size} alt="{c}"></a><figcaption>{c}</figcaption></figure>"#,
                 f = escape(file),
                 c = escape(caption)
             );
@@ -109,11 +197,36 @@ mod tests {
         a.number("cost", 12);
         a.figures.push(("a.svg".into(), "plan".into()));
         let b = StageReport::new("b", "Stage B", "paper §2");
-        let page = render("demo", &[a, b]);
+        a.number(
+            "collection",
+            serde_json::json!({"samples": 3, "why": "<streak>"}),
+        );
+        a.number("runs", serde_json::json!([{"n": 1, "ok": true}, {"n": 2}]));
+        let sizes = HashMap::from([("a.svg".to_string(), [240.0, 100.0])]);
+        let page = render("demo", &[a, b], &sizes);
         assert!(page.contains(r#"<h2 id="a">Stage &lt;A&gt;</h2>"#));
         assert!(page.contains(r#"<h2 id="b">"#));
-        assert!(page.contains(r#"<img src="a.svg""#));
+        // A small figure is shown larger (here 360 px high), in proportion.
+        assert!(
+            page.contains(r#"<img src="a.svg" width="864" height="360""#),
+            "{page}"
+        );
         assert_eq!(page.matches("class=\"failed\"").count(), 2);
         assert!(page.contains("<th>cost</th><td>12</td>"));
+        // No raw JSON: a record is a table in its cell, a list of records a table.
+        assert!(!page.contains('{') || page.find('{') < page.find("</style>"));
+        assert!(page.contains("<th>samples</th><td>3</td>"));
+        assert!(page.contains("<td>&lt;streak&gt;</td>"));
+        assert!(page.contains("<tr><th>n</th><th>ok</th></tr><tr><td>1</td><td>true</td></tr><tr><td>2</td><td></td></tr>"), "{page}");
+    }
+
+    #[test]
+    fn svg_size_reads_the_root_element() {
+        assert_eq!(
+            svg_size(r#"<svg font-family="x" height="90" viewBox="0 0 1 1" width="120.5">"#),
+            Some([120.5, 90.0])
+        );
+        assert_eq!(svg_size("<svg>"), None);
+        assert_eq!(svg_size("no svg"), None);
     }
 }

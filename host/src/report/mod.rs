@@ -63,6 +63,8 @@ pub struct Report {
     title: String,
     stages: Vec<StageReport>,
     png: bool,
+    /// Each figure's own size (by file name), for the page.
+    sizes: std::sync::Mutex<std::collections::HashMap<String, [f64; 2]>>,
 }
 
 /// The summary written as `summary.json`.
@@ -86,6 +88,7 @@ impl Report {
             title: title.into(),
             stages: Vec::new(),
             png,
+            sizes: Default::default(),
         })
     }
 
@@ -100,10 +103,17 @@ impl Report {
         let file = format!("{name}.svg");
         let path = self.dir.join(&file);
         std::fs::write(&path, svg).with_context(|| format!("writing {}", path.display()))?;
-        if self.png {
+        let file = if self.png {
             let png = self.dir.join(format!("{name}.png"));
             crate::plot::svg_to_png(svg, &png)?;
-            return Ok(format!("{name}.png"));
+            format!("{name}.png")
+        } else {
+            file
+        };
+        if let Some(size) = html::svg_size(svg)
+            && let Ok(mut sizes) = self.sizes.lock()
+        {
+            sizes.insert(file.clone(), size);
         }
         Ok(file)
     }
@@ -133,7 +143,8 @@ impl Report {
         let json = serde_json::to_string_pretty(&summary)?;
         let path = self.dir.join("summary.json");
         std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
-        let html = html::render(&self.title, &self.stages);
+        let sizes = self.sizes.lock().map(|s| s.clone()).unwrap_or_default();
+        let html = html::render(&self.title, &self.stages, &sizes);
         let path = self.dir.join("report.html");
         std::fs::write(&path, html).with_context(|| format!("writing {}", path.display()))?;
         Ok(path)

@@ -22,9 +22,12 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
         .chain(outline.iter().flat_map(|v| [v[0].abs(), v[1].abs()]))
         .fold(0.1f64, f64::max)
         + 0.05;
-    let f = Frame::region([-half, -half], [half, half], 2000.0);
+    let f = Frame::region([-half, -half], [half, half], 2000.0)
+        .with_margin(44.0)
+        .with_band(24.0);
     let mut d = Doc::for_frame(&f);
     d.background(&Style::new().fill("white"));
+    crate::plot::axes::metre_axes(&mut d, &f, [-half, -half], [half, half]);
     d.polygon(
         &f.map_all(outline),
         &Style::new().fill("lightgrey").stroke("black"),
@@ -42,7 +45,14 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
             &Style::new().stroke(&c).width(1.0).opacity(0.6),
         );
     }
-    d.caption(&format!("{} samples", samples.len()), 16.0, &Style::new());
+    d.caption(
+        &format!(
+            "{} samples (object frame, origin at its marker)",
+            samples.len()
+        ),
+        16.0,
+        &Style::new(),
+    );
     d.to_string()
 }
 
@@ -88,7 +98,10 @@ mod tests {
             theta: 0.0,
         };
         let svg = strategy_svg(&[smp; 3], &[[-0.05, -0.05], [0.05, -0.05], [0.0, 0.05]]);
-        assert_eq!(svg.matches("<line").count(), 6);
+        // Two per sample, besides the axes' ticks (drawn in #444).
+        let ticks = svg.matches(r##"stroke="#444""##).count();
+        assert!(ticks >= 6, "axes in metres");
+        assert_eq!(svg.matches("<line").count() - ticks, 6);
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     }
 }

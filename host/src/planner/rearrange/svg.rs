@@ -125,27 +125,42 @@ fn panel(g: &mut Group, model: &Model, before: &Config, steps: &[&Config], title
 
 /// Draw the plan as an SVG document of step panels.
 pub fn plan_svg(model: &Model, plan: &Plan) -> String {
+    plan_svg_in(model, plan, None)
+}
+
+/// [`plan_svg`] with axes in metres on every panel when the grid's cells are `cell` metres
+/// wide (row 0 along the table's far edge, so y counts up from the last row).
+pub fn plan_svg_in(model: &Model, plan: &Plan, cell: Option<f64>) -> String {
     let grid = &model.problem.grid;
+    // Room for the axes' labels on the left and below.
+    let (left, below) = if cell.is_some() {
+        (34.0, 18.0)
+    } else {
+        (0.0, 0.0)
+    };
     let st = stages(plan);
     let panels = st.len().max(1);
     let cols = panels.min(3);
     let rows = panels.div_ceil(cols);
-    let pw = grid.w as f64 * CELL + 2.0 * PAD;
-    let ph = grid.h as f64 * CELL + 2.0 * PAD + 14.0;
+    let pw = grid.w as f64 * CELL + 2.0 * PAD + left;
+    let ph = grid.h as f64 * CELL + 2.0 * PAD + 14.0 + below;
     let mut d = Doc::new(cols as f64 * pw, rows as f64 * ph);
     d.title(&model.problem.name);
     d.arrow_marker("arrow", BLUE);
     d.background(&Style::new().fill("white"));
     let mut before = plan.start.clone();
     if st.is_empty() {
-        let mut g = Group::translated(PAD, PAD + 14.0);
+        let mut g = Group::translated(PAD + left, PAD + 14.0);
         let title = format!("{}: already at the goal", model.problem.name);
         panel(&mut g, model, &before, &[], &title);
+        if let Some(c) = cell {
+            axes(&mut g, grid.w, grid.h, c);
+        }
         d.group(g);
     }
     for (n, range) in st.iter().enumerate() {
         let (col, row) = (n % cols, n / cols);
-        let mut g = Group::translated(col as f64 * pw + PAD, row as f64 * ph + PAD + 14.0);
+        let mut g = Group::translated(col as f64 * pw + PAD + left, row as f64 * ph + PAD + 14.0);
         let cfgs: Vec<&Config> = plan.steps[range.clone()]
             .iter()
             .map(|p| &p.config)
@@ -162,10 +177,40 @@ pub fn plan_svg(model: &Model, plan: &Plan) -> String {
             pushes
         );
         panel(&mut g, model, &before, &cfgs, &title);
+        if let Some(c) = cell {
+            axes(&mut g, grid.w, grid.h, c);
+        }
         d.group(g);
         if let Some(c) = cfgs.last() {
             before = (*c).clone();
         }
     }
     d.to_string()
+}
+
+/// Ticks in metres along a panel's bottom and left edges (cells of `cell` metres).
+fn axes(g: &mut Group, w: i32, h: i32, cell: f64) {
+    let step = crate::plot::axes::tick_step(f64::from(w.max(h)) * cell);
+    let every = (step / cell).round().max(1.0) as usize;
+    let ink = Style::new().stroke("#444");
+    let label = Style::new().fill("#333").font_size(9.0);
+    let bottom = f64::from(h) * CELL;
+    for x in (0..=w).step_by(every) {
+        let px = f64::from(x) * CELL;
+        g.line([px, bottom], [px, bottom + 4.0], &ink);
+        let text = format!("{:.1}", f64::from(x) * cell);
+        g.text([px, bottom + 13.0], &text, &label.clone().anchor("middle"));
+    }
+    for y in (0..=h).step_by(every) {
+        // Row `h - y` from the top is `y` cells up from the near edge.
+        let py = bottom - f64::from(y) * CELL;
+        g.line([-4.0, py], [0.0, py], &ink);
+        let text = format!("{:.1}", f64::from(y) * cell);
+        g.text([-6.0, py + 3.0], &text, &label.clone().anchor("end"));
+    }
+    g.text(
+        [f64::from(w) * CELL, bottom + 13.0],
+        "m",
+        &label.anchor("start"),
+    );
 }

@@ -8,11 +8,13 @@ use crate::plot::svg::{Doc, Draw, Frame, Style};
 
 /// The longer table side in user units.
 const SIDE: f64 = 600.0;
+/// Room around the table for the axes in metres.
+const AXES_MARGIN: f64 = 44.0;
 
 /// Render a plan (or just the problem if no plan) as an SVG document.
 pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
     let (w, h) = p.world.table;
-    let f = Frame::table(w, h, SIDE / w.max(h));
+    let f = Frame::table(w, h, SIDE / w.max(h)).with_margin(AXES_MARGIN);
     let map = |pts: &[V2]| -> Vec<[f64; 2]> { pts.iter().map(|v| f.map([v.x, v.y])).collect() };
     let mut d = Doc::for_frame(&f);
     let (at, size) = f.area();
@@ -21,6 +23,7 @@ pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
         size,
         &Style::new().fill("white").stroke("black").width(2.0),
     );
+    crate::plot::axes::metre_axes(&mut d, &f, [0.0, 0.0], [w, h]);
     for o in &p.world.obstacles[p.world.n_walls..] {
         d.polygon(
             &map(&o.vertices),

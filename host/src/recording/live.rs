@@ -1,0 +1,87 @@
+//! What a robot seen by a camera ([`crate::exec::LiveRobot`]) records: a session when it
+//! connects, then at every look the robot's reports since the last look (telemetry at its full
+//! rate, contacts, motions' ends) and the camera frame with what tracking made of it.
+
+use std::sync::mpsc::Receiver;
+
+use pushbot_world::Scene;
+
+use super::RecordingHandle;
+use super::writer::SessionInfo;
+use crate::link::RobotEvent;
+use crate::robot::Robot;
+use crate::vision::FrameResult;
+use crate::vision::calibration::Calibration;
+use crate::vision::detect::DetectorKind;
+use crate::vision::frame::Frame;
+use crate::vision::layout::MarkerLayout;
+use crate::vision::tracking::TrackerParams;
+
+/// A live robot's link to a recording.
+pub struct LiveRecording {
+    handle: RecordingHandle,
+    events: Receiver<RobotEvent>,
+}
+
+impl std::fmt::Debug for LiveRecording {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LiveRecording")
+    }
+}
+
+/// The robot's clock now, µs (its latest telemetry).
+fn robot_us(robot: &Robot) -> u64 {
+    robot.telemetry().map_or(0, |t| t.time_us)
+}
+
+impl LiveRecording {
+    /// Start a session for `robot` over `scene`, with the tracking set up as given.
+    pub fn start(
+        handle: &RecordingHandle,
+        robot: &Robot,
+        scene: &Scene,
+        layout: &MarkerLayout,
+        calibration: &Calibration,
+        tracker: TrackerParams,
+        detector: DetectorKind,
+    ) -> LiveRecording {
+        let events = robot.subscribe();
+        let info = SessionInfo {
+            label: &scene.name,
+            scene: Some(scene),
+            layout,
+            calibration,
+            tracker,
+            detector,
+            whole_frames: false,
+        };
+        handle.with(|r| r.begin_session(&info, robot_us(robot)));
+        LiveRecording {
+            handle: handle.clone(),
+            events,
+        }
+    }
+
+    /// A look: the robot's reports since the last one, then `frame` and its result.
+    pub fn look(&self, robot: &Robot, frame: &Frame, result: &FrameResult, cal: &Calibration) {
+        let now = robot_us(robot);
+        self.handle.with(|r| {
+            for e in self.events.try_iter() {
+                r.robot_event(&e)?;
+            }
+            r.frame(now, frame, result, cal)
+        });
+    }
+}
+
+impl Drop for LiveRecording {
+    /// The robot's reports since the last look (the end of the last motion) are recorded too.
+    fn drop(&mut self) {
+        self.handle.with(|r| {
+            for e in self.events.try_iter() {
+                r.robot_event(&e)?;
+            }
+            r.flush()
+        });
+    }
+}
