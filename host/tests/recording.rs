@@ -17,7 +17,12 @@ fn pushbot(args: &[&str]) -> std::process::Output {
 }
 
 fn demo(dir: &Path) -> std::path::PathBuf {
-    let out = pushbot(&[
+    demo_with(dir, &[])
+}
+
+fn demo_with(dir: &Path, before: &[&str]) -> std::path::PathBuf {
+    let mut args = before.to_vec();
+    args.extend([
         "demo",
         "--stages",
         "stable",
@@ -25,6 +30,7 @@ fn demo(dir: &Path) -> std::path::PathBuf {
         dir.to_str().expect("utf-8"),
         "--json",
     ]);
+    let out = pushbot(&args);
     assert!(
         out.status.success(),
         "{}",
@@ -162,4 +168,50 @@ fn bad_recordings_are_refused_clearly() {
     junk.extend((0..4000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8));
     let r = reader::read_bytes(&junk);
     assert!(r.is_err() || r.as_ref().is_ok_and(|c| c.cut.is_some()));
+}
+
+/// Through a distorting lens (`--intrinsics`, a webcam's k1 = −0.08): the stage still reaches
+/// its goal, the recording publishes the lens as the camera's calibration and keeps it for
+/// replay, which tracks the frames again through it to the same poses.
+#[test]
+fn a_run_through_a_lens_is_recorded_with_it_and_replays_the_same() {
+    use pushbot_world::lens::{Distortion, Intrinsics};
+    use pushbot_world::lens_file::{LensFormat, write_intrinsics};
+    let dir = tempfile::tempdir().expect("tmp");
+    let lens = Intrinsics {
+        width: 960,
+        height: 720,
+        fx: 700.0,
+        fy: 700.0,
+        cx: 480.0,
+        cy: 360.0,
+        distortion: Distortion {
+            k1: -0.08,
+            ..Distortion::NONE
+        },
+    };
+    let yaml = dir.path().join("webcam.yaml");
+    std::fs::write(&yaml, write_intrinsics(&lens, LensFormat::OpenCv, "webcam")).expect("write");
+    let out = dir.path().join("out");
+    let file = demo_with(&out, &["--intrinsics", yaml.to_str().expect("utf-8")]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).expect("summary"))
+            .expect("json");
+    assert_eq!(summary["success"], true, "{summary:#}");
+    let rec = reader::read(&file).expect("readable");
+    let cal = rec.on(topics::CALIBRATION).next().expect("calibration");
+    assert_eq!(cal.value["D"][0].as_f64(), Some(-0.08));
+    assert_eq!(cal.value["K"][0].as_f64(), Some(700.0));
+    let out = pushbot(&["replay", file.to_str().expect("utf-8"), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let diff = v["max_diff_m"].as_f64().expect("max_diff_m");
+    assert!(
+        diff <= 1e-4,
+        "replayed through the lens, poses differ by {diff} m"
+    );
 }

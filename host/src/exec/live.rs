@@ -194,16 +194,17 @@ impl LiveRobot {
             ..TrackerParams::default()
         };
         let recording = opts.recording.as_ref().map(|h| {
-            let d = opts.detector;
-            crate::recording::live::LiveRecording::start(
-                h,
-                &robot,
-                scene,
-                &layout,
-                &calibration,
-                params,
-                d,
-            )
+            let info = crate::recording::writer::SessionInfo {
+                label: &scene.name,
+                scene: Some(scene),
+                layout: &layout,
+                calibration: &calibration,
+                tracker: params,
+                detector: opts.detector,
+                whole_frames: false,
+                lens: lens.as_ref(),
+            };
+            crate::recording::live::LiveRecording::start(h, &robot, &info)
         });
         let pipeline = Pipeline::new(detector, layout, calibration, params);
         let pipeline = match lens {

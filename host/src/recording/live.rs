@@ -4,18 +4,13 @@
 
 use std::sync::mpsc::Receiver;
 
-use pushbot_world::Scene;
-
 use super::RecordingHandle;
 use super::writer::SessionInfo;
 use crate::link::RobotEvent;
 use crate::robot::Robot;
 use crate::vision::FrameResult;
 use crate::vision::calibration::Calibration;
-use crate::vision::detect::DetectorKind;
 use crate::vision::frame::Frame;
-use crate::vision::layout::MarkerLayout;
-use crate::vision::tracking::TrackerParams;
 
 /// A live robot's link to a recording.
 pub struct LiveRecording {
@@ -35,27 +30,10 @@ fn robot_us(robot: &Robot) -> u64 {
 }
 
 impl LiveRecording {
-    /// Start a session for `robot` over `scene`, with the tracking set up as given.
-    pub fn start(
-        handle: &RecordingHandle,
-        robot: &Robot,
-        scene: &Scene,
-        layout: &MarkerLayout,
-        calibration: &Calibration,
-        tracker: TrackerParams,
-        detector: DetectorKind,
-    ) -> LiveRecording {
+    /// Start a session for `robot`, described by `info` (scene, tracking set-up, lens).
+    pub fn start(handle: &RecordingHandle, robot: &Robot, info: &SessionInfo<'_>) -> LiveRecording {
         let events = robot.subscribe();
-        let info = SessionInfo {
-            label: &scene.name,
-            scene: Some(scene),
-            layout,
-            calibration,
-            tracker,
-            detector,
-            whole_frames: false,
-        };
-        handle.with(|r| r.begin_session(&info, robot_us(robot)));
+        handle.with(|r| r.begin_session(info, robot_us(robot)));
         LiveRecording {
             handle: handle.clone(),
             events,

@@ -93,6 +93,8 @@ pub struct SessionInfo<'a> {
     pub detector: crate::vision::detect::DetectorKind,
     /// Whether every frame was searched whole (no regions of interest).
     pub whole_frames: bool,
+    /// The camera's lens, when detections are undistorted through one.
+    pub lens: Option<&'a pushbot_world::lens::Intrinsics>,
 }
 
 /// An MCAP file being written.
@@ -253,6 +255,7 @@ impl Recording {
             "tracker": info.tracker,
             "detector": info.detector,
             "whole_frames": info.whole_frames,
+            "lens": info.lens,
         });
         self.put(topics::SESSION, ns, &msg)?;
         if let Some(scene) = info.scene {
@@ -261,7 +264,7 @@ impl Recording {
         self.put(
             topics::CALIBRATION,
             ns,
-            &foxglove::camera_calibration(ns, info.calibration),
+            &foxglove::camera_calibration(ns, info.calibration, info.lens),
         )?;
         self.log_at(
             ns,
