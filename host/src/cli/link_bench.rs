@@ -130,5 +130,6 @@ pub fn run(g: &Global, a: &BenchLinkArgs) -> CliResult {
 #[cfg(not(feature = "sim"))]
 pub fn run(_g: &Global, a: &BenchLinkArgs) -> CliResult {
     probability("corrupt", a.corrupt)?;
+    seconds("cut-every", a.cut_every)?;
     Err(super::no_simulated_target())
 }
