@@ -100,6 +100,16 @@ fn demo_records_and_replay_reproduces_the_tracked_poses() {
     let page = v["report"].as_str().expect("report");
     let html = std::fs::read_to_string(page).expect("report.html");
     assert!(html.contains("<figure"), "the replay report has figures");
+    // The live report as recorded: the stage's numbers and the very same figures.
+    assert!(
+        html.contains("pushed_m"),
+        "the stage's numbers are in the replay report"
+    );
+    for f in ["stable-plan.svg", "stable-run.svg"] {
+        let live = std::fs::read_to_string(dir.path().join(f)).expect("live figure");
+        let again = std::fs::read_to_string(dir.path().join("replay").join(f)).expect(f);
+        assert_eq!(live, again, "{f} differs in the replay report");
+    }
     // The run drawn from the recording is the live report's figure, but for its title.
     let live = std::fs::read_to_string(dir.path().join("stable-run.svg")).expect("live figure");
     let again = std::fs::read_to_string(dir.path().join("replay/session-1-run.svg"))

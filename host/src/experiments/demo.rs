@@ -115,6 +115,20 @@ pub fn run(opts: &DemoOptions) -> Result<(Report, PathBuf)> {
         for r in &recoveries {
             rep.notes.push(recovery_note(r));
         }
+        if let Some(rec) = &ctx.recording {
+            // The stage's report goes into the recording with its figures' SVG text, so that a
+            // replay writes the same report.
+            let mut svgs = std::collections::BTreeMap::new();
+            for (file, _) in &rep.figures {
+                let stem = file.rsplit_once('.').map_or(file.as_str(), |(s, _)| s);
+                if let Ok(svg) =
+                    std::fs::read_to_string(ctx.report.dir().join(format!("{stem}.svg")))
+                {
+                    svgs.insert(stem.to_string(), svg);
+                }
+            }
+            rec.with(|r| r.stage_report(&rep, &svgs));
+        }
         ctx.log(&format!(
             "stage {stage}: {} in {:.1} s wall, {:.1} s mission time",
             if rep.success { "reached" } else { "FAILED" },

@@ -76,6 +76,12 @@ pub struct Replay {
     pub max_diff_rad: f64,
     /// Why the file ended early, if it did.
     pub cut: Option<String>,
+    /// The live run's stage reports with their figures (file stem → SVG), as recorded.
+    #[serde(skip)]
+    pub stages: Vec<(
+        crate::report::StageReport,
+        std::collections::BTreeMap<String, String>,
+    )>,
 }
 
 struct Live {
@@ -147,6 +153,7 @@ fn frame_of(png: &[u8], seq: u64, time: f64) -> Result<Frame> {
 pub fn replay(contents: &Contents) -> Result<Replay> {
     let mut done = Vec::new();
     let mut live: Option<Live> = None;
+    let mut stages = Vec::new();
     for m in &contents.messages {
         match m.topic.as_str() {
             topics::SESSION => {
@@ -183,6 +190,13 @@ pub fn replay(contents: &Contents) -> Result<Replay> {
                 l.info.frames += 1;
                 compare(&mut l.info, &r, &m.value)?;
             }
+            topics::STAGE => {
+                let report = serde_json::from_value(m.value["report"].clone())
+                    .context("a recorded stage report")?;
+                let figures = serde_json::from_value(m.value["figures"].clone())
+                    .context("a recorded stage report's figures")?;
+                stages.push((report, figures));
+            }
             topics::TRACE => {
                 if let Some(l) = live.as_mut()
                     && let Ok(p) = trace_point(&m.value)
@@ -205,6 +219,7 @@ pub fn replay(contents: &Contents) -> Result<Replay> {
         max_diff_rad: done.iter().map(|s| s.max_diff_rad).fold(0.0, f64::max),
         sessions: done,
         cut: contents.cut.clone(),
+        stages,
     })
 }
 

@@ -1,7 +1,7 @@
-//! The report of a replay (`pushbot replay FILE.mcap --out DIR`): the same report folder as a
-//! live run's ([`crate::report`]), a section per recorded session with the run drawn from the
-//! recorded trace (the same figure as the live report's) and the paths the replayed tracking
-//! gives, and how far the replayed poses are from the recorded ones.
+//! The report of a replay (`pushbot replay FILE.mcap --out DIR`): the live run's report as it
+//! was recorded (every stage's numbers, notes and figures, the same files), then a section per
+//! recorded session with the run drawn from the recorded trace and the paths the replayed
+//! tracking gives, and how far the replayed poses are from the recorded ones.
 
 use std::path::{Path, PathBuf};
 
@@ -41,6 +41,20 @@ fn tracked_trace(s: &SessionReplay) -> Vec<TracePoint> {
 /// Write the report of `replay` into `dir`; returns `report.html`'s path.
 pub fn write(replay: &Replay, dir: &Path, recording: &Path) -> Result<PathBuf> {
     let mut report = Report::create(dir, "pushbot replay", false)?;
+    // The live run's own report, as recorded: the same stages, numbers, notes and figures.
+    for (stage, svgs) in &replay.stages {
+        let mut st = stage.clone();
+        for (file, _) in &mut st.figures {
+            let stem = file
+                .rsplit_once('.')
+                .map_or(file.as_str(), |(s, _)| s)
+                .to_string();
+            if let Some(svg) = svgs.get(&stem) {
+                *file = report.figure(&stem, svg)?;
+            }
+        }
+        report.add(st);
+    }
     for s in &replay.sessions {
         let mut st = StageReport::new(
             &format!("session-{}", s.session),

@@ -264,3 +264,12 @@ pub fn trace_point() -> Value {
            "properties": {"t": num(), "after": string(), "robot": {"type": "object"},
                           "objects": {"type": "array"}}})
 }
+
+/// `pushbot.StageReport`: a stage's report as the live run wrote it (numbers, notes, captions)
+/// with its figures' SVG text, so that `pushbot replay` writes the same report.
+pub fn stage_report() -> Value {
+    json!({"title": "pushbot.StageReport", "type": "object",
+           "properties": {"report": {"type": "object"},
+                          "figures": {"type": "object",
+                                      "description": "figure file stem -> SVG text"}}})
+}

@@ -43,6 +43,7 @@ pub fn channels() -> Vec<(&'static str, Value)> {
         (topics::TRACKED, schema::tracked()),
         (topics::SESSION, schema::session()),
         (topics::TRACE, schema::trace_point()),
+        (topics::STAGE, schema::stage_report()),
     ]
 }
 
@@ -74,6 +75,8 @@ pub mod topics {
     pub const SESSION: &str = "/pushbot/session";
     /// `pushbot.TracePoint`.
     pub const TRACE: &str = "/pushbot/trace";
+    /// `pushbot.StageReport`.
+    pub const STAGE: &str = "/pushbot/stage";
 }
 
 /// What a replay needs of a session, besides its frames.
@@ -368,6 +371,22 @@ impl Recording {
     pub fn trace(&mut self, point: &crate::exec::record::TracePoint) -> Result<()> {
         let ns = self.last_ns;
         self.put(topics::TRACE, ns, &serde_json::to_value(point)?)
+    }
+
+    /// A stage's finished report with its figures (file stem → SVG text), at the latest time
+    /// written; flushed at once.
+    pub fn stage_report(
+        &mut self,
+        report: &crate::report::StageReport,
+        figures: &BTreeMap<String, String>,
+    ) -> Result<()> {
+        let ns = self.last_ns;
+        self.put(
+            topics::STAGE,
+            ns,
+            &json!({"report": report, "figures": figures}),
+        )?;
+        self.flush()
     }
 
     /// A log line (`level`: 1 debug, 2 info, 3 warning, 4 error) at the latest time written.
