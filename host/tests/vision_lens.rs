@@ -91,6 +91,16 @@ fn poses_off_the_table_are_dropped_and_counted() {
         let detector =
             Box::new(AprilTagC::new(&l.families(), &AprilTagCConfig::default()).unwrap());
         let mut p = Pipeline::new(detector, l, cal.clone(), TrackerParams::default());
+        // A frame of another size than the calibration's: refused, not measured.
+        let small = pushbot::vision::frame::Frame {
+            seq: 0,
+            time: 0.0,
+            width: 640,
+            height: 480,
+            pixels: vec![128; 640 * 480],
+        };
+        let e = p.process(&small).expect_err("another size").to_string();
+        assert!(e.contains("640×480") && e.contains("960×720"), "{e}");
         let r = p.process(&frames[0].frame).unwrap();
         if want_off {
             assert!(r.off_table >= 4, "{}", r.off_table);
@@ -100,4 +110,159 @@ fn poses_off_the_table_are_dropped_and_counted() {
             assert!(r.tracked.len() >= 4 && r.tracked.iter().all(|t| !t.lost));
         }
     }
+}
+
+/// The command line through a lens: `pushbot --intrinsics FILE calibrate` keeps the lens in the
+/// calibration it saves, `track` with that calibration measures through it (the robot where it
+/// is); `track --intrinsics` with a calibration made without the lens is refused (exit 2), and so
+/// is a lens made for another image size.
+#[test]
+fn calibrate_and_track_through_a_lens_on_the_command_line() {
+    use pushbot_world::lens_file::{LensFormat, write_intrinsics};
+    let dir = tempfile::tempdir().unwrap();
+    let frames_dir = dir.path().join("frames");
+    std::fs::create_dir_all(&frames_dir).unwrap();
+    let layout = MarkerLayout::default_table();
+    let params = SynthParams {
+        lens: Some(webcam()),
+        ..SynthParams::default()
+    };
+    let frames = synth::frames(&layout, 3, 45, &params).unwrap();
+    for f in &frames {
+        pushbot_sim::camera::CameraFrame {
+            seq: f.frame.seq,
+            time: f.frame.time,
+            width: f.frame.width,
+            height: f.frame.height,
+            pixels: f.frame.pixels.clone(),
+            truth: f.markers.clone(),
+        }
+        .write_png(&frames_dir)
+        .unwrap();
+    }
+    let lay = dir.path().join("layout.json");
+    std::fs::write(&lay, serde_json::to_string(&layout).unwrap()).unwrap();
+    let yaml = dir.path().join("webcam.yaml");
+    std::fs::write(
+        &yaml,
+        write_intrinsics(&webcam(), LensFormat::Ros, "webcam"),
+    )
+    .unwrap();
+    let small = dir.path().join("small.yaml");
+    let other = Intrinsics {
+        width: 640,
+        height: 480,
+        cx: 320.0,
+        cy: 240.0,
+        ..webcam()
+    };
+    std::fs::write(&small, write_intrinsics(&other, LensFormat::Ros, "small")).unwrap();
+    let (cam, lay) = (frames_dir.to_str().unwrap(), lay.to_str().unwrap());
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_pushbot"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let cal = dir.path().join("cal.json");
+    let (cal_s, yaml_s) = (cal.to_str().unwrap(), yaml.to_str().unwrap());
+    let out = run(&[
+        "--intrinsics",
+        yaml_s,
+        "calibrate",
+        "--camera",
+        cam,
+        "--layout",
+        lay,
+        "--out",
+        cal_s,
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    assert_eq!(saved["lens"]["distortion"]["k1"].as_f64(), Some(-0.08));
+    assert!(saved["rms_px"].as_f64().unwrap() < 0.2, "{saved}");
+    let out = run(&[
+        "track",
+        "--camera",
+        cam,
+        "--layout",
+        lay,
+        "--calibration",
+        cal_s,
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let first: serde_json::Value = serde_json::from_str(
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .next()
+            .unwrap(),
+    )
+    .unwrap();
+    let robot = first["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["id"] == "robot")
+        .unwrap()
+        .clone();
+    let (name, pose) = &frames[0].bodies[0];
+    assert_eq!(name, "robot");
+    let off = (robot["x"].as_f64().unwrap() - pose.x).hypot(robot["y"].as_f64().unwrap() - pose.y);
+    assert!(
+        off < 0.001,
+        "the robot is {} mm off through the lens",
+        off * 1e3
+    );
+    // A calibration without the lens, used with it: refused.
+    let plain = dir.path().join("plain.json");
+    let out = run(&[
+        "calibrate",
+        "--camera",
+        cam,
+        "--layout",
+        lay,
+        "--out",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let out = run(&[
+        "--intrinsics",
+        yaml_s,
+        "track",
+        "--camera",
+        cam,
+        "--layout",
+        lay,
+        "--calibration",
+        plain.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("calibrate again"));
+    // A lens for 640×480 frames on 960×720 ones: refused, saying both sizes.
+    let out = run(&[
+        "--intrinsics",
+        small.to_str().unwrap(),
+        "calibrate",
+        "--camera",
+        cam,
+        "--layout",
+        lay,
+        "--out",
+        dir.path().join("x.json").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("640×480") && err.contains("960×720"), "{err}");
 }

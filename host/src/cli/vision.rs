@@ -119,6 +119,7 @@ fn calibrate_from(
     args: &CameraArgs,
     lay: &MarkerLayout,
     n: usize,
+    lens: Option<&pushbot_world::lens::Intrinsics>,
 ) -> Result<Result<Calibration, String>, CliError> {
     let mut det =
         make_detector(args.detector, &lay.families()).map_err(|e| CliError::Failed(e.into()))?;
@@ -137,7 +138,12 @@ fn calibrate_from(
             src.describe()
         )));
     }
-    Ok(Calibration::fit(&all, lay, size).map_err(|e| e.to_string()))
+    match Calibration::fit_through(&all, lay, size, lens) {
+        Err(e @ crate::vision::calibration::CalibrationError::Lens(_)) => {
+            Err(CliError::bad_input(format!("--intrinsics: {e}")))
+        }
+        r => Ok(r.map_err(|e| e.to_string())),
+    }
 }
 
 /// `pushbot calibrate`.
@@ -147,7 +153,8 @@ pub fn calibrate(g: &Global, args: CalibrateArgs) -> CliResult {
         return Err(CliError::bad_input("--frames must be at least 1"));
     }
     let mut src = source(&args.camera)?;
-    let cal = match calibrate_from(src.as_mut(), &args.camera, &lay, args.frames)? {
+    let lens = g.lens()?;
+    let cal = match calibrate_from(src.as_mut(), &args.camera, &lay, args.frames, lens.as_ref())? {
         Ok(c) => c,
         Err(msg) => return Ok(super::task_failed(g, &msg)),
     };
@@ -182,10 +189,23 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     if args.frames == Some(0) {
         return Err(CliError::bad_input("--frames must be at least 1"));
     }
+    let lens = g.lens()?;
+    if let (Some(c), Some(_)) = (&saved, &lens)
+        && c.lens != lens
+    {
+        return Err(CliError::bad_input(format!(
+            "--calibration was made {} --intrinsics: calibrate again with it",
+            if c.lens.is_some() {
+                "through another lens than"
+            } else {
+                "without"
+            }
+        )));
+    }
     let mut src = source(&args.camera)?;
     let cal = match saved {
         Some(c) => c,
-        None => match calibrate_from(src.as_mut(), &args.camera, &lay, 1)? {
+        None => match calibrate_from(src.as_mut(), &args.camera, &lay, 1, lens.as_ref())? {
             Ok(c) => c,
             Err(msg) => return Ok(super::task_failed(g, &msg)),
         },

@@ -183,6 +183,14 @@ impl LiveRobot {
         let families = layout.families();
         let lens = opts.lens.or(scene.camera.lens);
         let calibration = match &opts.calibration {
+            Some(c) if lens.is_some() && c.lens != lens => bail!(
+                "the saved calibration was made {} the camera's lens: calibrate again with it",
+                if c.lens.is_some() {
+                    "through another lens than"
+                } else {
+                    "without"
+                }
+            ),
             Some(c) => c.clone(),
             None => calibrate(&grabber, &layout, opts.detector, opts.frame_timeout, lens)?,
         };
@@ -207,10 +215,6 @@ impl LiveRobot {
             crate::recording::live::LiveRecording::start(h, &robot, &info)
         });
         let pipeline = Pipeline::new(detector, layout, calibration, params);
-        let pipeline = match lens {
-            Some(l) => pipeline.with_lens(l),
-            None => pipeline,
-        };
         let view = match &opts.view_dir {
             Some(d) => Some(super::view::LiveView::create(d)?),
             None => None,
@@ -474,18 +478,9 @@ fn calibrate(
         let (n, frame) = grabber.next_after(after, timeout)?;
         after = n;
         size = [frame.width, frame.height];
-        let dets = det.detect(&frame)?;
-        frames.push(match &lens {
-            Some(l) => {
-                if let Some(why) = crate::vision::undistort::lens_mismatch(l, size) {
-                    bail!("{why}");
-                }
-                crate::vision::undistort::undistort_detections(&dets, l)
-            }
-            None => dets,
-        });
+        frames.push(det.detect(&frame)?);
     }
-    Calibration::fit(&frames, layout, size).context("calibrating the camera")
+    Calibration::fit_through(&frames, layout, size, lens.as_ref()).context("calibrating the camera")
 }
 
 impl RobotIo for LiveRobot {

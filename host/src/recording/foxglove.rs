@@ -311,6 +311,7 @@ mod tests {
             mm_per_px: 1.0,
             markers: Vec::new(),
             points: 0,
+            lens: None,
         }
     }
 

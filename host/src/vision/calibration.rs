@@ -33,6 +33,10 @@ pub struct Calibration {
     pub markers: Vec<u32>,
     /// Number of point pairs.
     pub points: usize,
+    /// The lens the corners were undistorted through before the fit (issue 20): the pipeline
+    /// measures through the same lens. `None`: an ideal pinhole (raw corners).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
 /// Why calibration failed.
@@ -52,6 +56,9 @@ pub enum CalibrationError {
     /// Reading or writing the file failed.
     #[error("{0}")]
     File(String),
+    /// The lens does not fit the frames.
+    #[error("{0}")]
+    Lens(String),
 }
 
 impl Calibration {
@@ -118,7 +125,32 @@ impl Calibration {
             mm_per_px,
             markers: ids.into_iter().collect(),
             points: table.len(),
+            lens: None,
         })
+    }
+
+    /// Fit as [`Calibration::fit`] from raw detections seen through `lens` (if any): their
+    /// corners are undistorted first, and the calibration keeps the lens, which must be made for
+    /// frames of `image_size`.
+    pub fn fit_through(
+        frames: &[Vec<Detection>],
+        layout: &MarkerLayout,
+        image_size: [u32; 2],
+        lens: Option<&pushbot_world::lens::Intrinsics>,
+    ) -> Result<Calibration, CalibrationError> {
+        let Some(lens) = lens else {
+            return Calibration::fit(frames, layout, image_size);
+        };
+        if let Some(why) = super::undistort::lens_mismatch(lens, image_size) {
+            return Err(CalibrationError::Lens(why));
+        }
+        let ideal: Vec<Vec<Detection>> = frames
+            .iter()
+            .map(|d| super::undistort::undistort_detections(d, lens))
+            .collect();
+        let mut cal = Calibration::fit(&ideal, layout, image_size)?;
+        cal.lens = Some(*lens);
+        Ok(cal)
     }
 
     /// Write as pretty JSON.

@@ -198,6 +198,8 @@ impl Pipeline {
         calibration: Calibration,
         params: TrackerParams,
     ) -> Pipeline {
+        // A calibration fit through a lens measures through it ([`Calibration::fit_through`]).
+        let lens = calibration.lens;
         Pipeline {
             detector,
             layout,
@@ -206,13 +208,14 @@ impl Pipeline {
             roi: RoiParams::default(),
             since_full: 0,
             sightings: Vec::new(),
-            lens: None,
+            lens,
         }
     }
 
     /// The same pipeline for a camera with this lens: detected corners are undistorted before
-    /// they are measured (the calibration must have been fit on undistorted corners too,
-    /// [`undistort::undistort_detections`]).
+    /// they are measured (the calibration must have been fit on undistorted corners too; one
+    /// made by [`calibration::Calibration::fit_through`] carries its lens, which
+    /// [`Pipeline::new`] takes).
     pub fn with_lens(mut self, lens: pushbot_world::lens::Intrinsics) -> Pipeline {
         self.lens = Some(lens);
         self
@@ -364,6 +367,14 @@ impl Pipeline {
 
     /// Process one frame.
     pub fn process(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
+        if [frame.width, frame.height] != self.calibration.image_size {
+            let [w, h] = self.calibration.image_size;
+            return Err(DetectError::Failed(format!(
+                "the frame is {}×{}, the calibration was made for {w}×{h} frames: calibrate this \
+                 camera at this size",
+                frame.width, frame.height
+            )));
+        }
         let (detections, mut measurements, full_frame) = self.look(frame)?;
         let [w, d] = self.layout.table;
         let m = OFF_TABLE_MARGIN;
