@@ -266,3 +266,71 @@ fn calibrate_and_track_through_a_lens_on_the_command_line() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("640×480") && err.contains("960×720"), "{err}");
 }
+
+/// Markers at their true heights (issue 20): the robot's marker 6 cm and the objects' 3 cm above
+/// the table, seen through the lens in perspective. With the heights in the layout (the scene
+/// markers' `z`) and the lens known, the calibration knows the camera's centre and each marker
+/// is placed where its rays meet its own plane; with the heights left out, the same frames put
+/// bodies centimetres off.
+#[test]
+fn raised_markers_are_placed_on_their_own_plane() {
+    let mut layout = MarkerLayout::default_table();
+    for b in &mut layout.bodies {
+        b.height = if b.body == "robot" { 0.06 } else { 0.03 };
+    }
+    let params = SynthParams {
+        lens: Some(webcam()),
+        ..SynthParams::default()
+    };
+    let frames = synth::frames(&layout, 40, 46, &params).unwrap();
+    let mut det = AprilTagC::new(&layout.families(), &AprilTagCConfig::default()).unwrap();
+    let raw: Vec<_> = frames
+        .iter()
+        .map(|f| det.detect(&f.frame).unwrap())
+        .collect();
+    let cal = pushbot::vision::calibration::Calibration::fit_through(
+        &raw[..5],
+        &layout,
+        [960, 720],
+        Some(&webcam()),
+    )
+    .unwrap();
+    let c = cal
+        .camera_centre
+        .expect("the lens gives the camera's centre");
+    eprintln!("camera centre {c:?}");
+    let mut flat = layout.clone();
+    for b in &mut flat.bodies {
+        b.height = 0.0;
+    }
+    let mut medians = Vec::new();
+    for l in [&layout, &flat] {
+        let mut poses = PoseScore::default();
+        for (d, f) in raw.iter().zip(&frames) {
+            let fixed = undistort_detections(d, &webcam());
+            poses.add(&measure(&fixed, &cal, l), &f.bodies);
+        }
+        let med = quantile(&poses.pos_mm, 0.5);
+        eprintln!(
+            "position median {med:.3} mm, worst {:.3} mm over {}",
+            quantile(&poses.pos_mm, 1.0),
+            poses.pos_mm.len()
+        );
+        assert!(
+            poses.pos_mm.len() >= 40 * 3,
+            "bodies measured: {}",
+            poses.pos_mm.len()
+        );
+        medians.push(med);
+    }
+    assert!(
+        medians[0] <= 0.5,
+        "median {} mm with the heights",
+        medians[0]
+    );
+    assert!(
+        medians[1] > 5.0,
+        "the heights matter: {} mm without",
+        medians[1]
+    );
+}

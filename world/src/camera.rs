@@ -105,6 +105,10 @@ pub struct MarkerPlacement {
     pub heading: f64,
     /// Side of the black square, metres.
     pub side: f64,
+    /// Height of the printed square above the table, metres (a marker on top of a robot or a
+    /// box): a camera sees it in perspective, larger and shifted away from its nadir.
+    #[serde(default)]
+    pub height: f64,
 }
 
 impl MarkerPlacement {

@@ -312,6 +312,7 @@ mod tests {
             markers: Vec::new(),
             points: 0,
             lens: None,
+            camera_centre: None,
         }
     }
 

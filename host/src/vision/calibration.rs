@@ -37,6 +37,11 @@ pub struct Calibration {
     /// measures through the same lens. `None`: an ideal pinhole (raw corners).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lens: Option<pushbot_world::lens::Intrinsics>,
+    /// The camera's centre in the table frame (metres, z up), known when the lens is: from the
+    /// homography and the intrinsics (`H = K [r1 r2 t]`, Zhang's extrinsics for one view). A
+    /// marker at a height is then placed where its ray meets its own plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera_centre: Option<[f64; 3]>,
 }
 
 /// Why calibration failed.
@@ -126,6 +131,7 @@ impl Calibration {
             markers: ids.into_iter().collect(),
             points: table.len(),
             lens: None,
+            camera_centre: None,
         })
     }
 
@@ -150,6 +156,7 @@ impl Calibration {
             .collect();
         let mut cal = Calibration::fit(&ideal, layout, image_size)?;
         cal.lens = Some(*lens);
+        cal.camera_centre = camera_centre(&cal.table_to_pixel, lens);
         Ok(cal)
     }
 
@@ -190,9 +197,24 @@ impl Calibration {
     /// table and the marker's square is fitted to them (2-D Procrustes: rotation and
     /// translation). Also returns the fitted side length, metres.
     pub fn marker_pose(&self, d: &Detection) -> Option<(Pose, f64)> {
+        self.marker_pose_at(d, 0.0)
+    }
+
+    /// As [`Calibration::marker_pose`] for a marker `height` metres above the table: each
+    /// corner's ray, met with the table, is moved back along the ray to the marker's plane —
+    /// when the camera's centre is known ([`Calibration::camera_centre`]); otherwise the marker
+    /// is taken to lie on the table.
+    pub fn marker_pose_at(&self, d: &Detection, height: f64) -> Option<(Pose, f64)> {
         let mut q = [[0.0; 2]; 4];
         for (k, c) in d.corners.iter().enumerate() {
             q[k] = self.pixel_to_table.apply(*c)?;
+            if let Some(cc) = self.camera_centre
+                && height != 0.0
+                && cc[2] > height
+            {
+                let f = (cc[2] - height) / cc[2];
+                q[k] = [cc[0] + (q[k][0] - cc[0]) * f, cc[1] + (q[k][1] - cc[1]) * f];
+            }
         }
         // The square's corners about its centre, unit half-side: BL, BR, TR, TL.
         let local = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
@@ -211,6 +233,29 @@ impl Calibration {
         (cx.is_finite() && cy.is_finite() && theta.is_finite())
             .then_some((Pose::new(cx, cy, theta), side))
     }
+}
+
+/// The camera's centre in the table frame from the table → ideal-pixel homography and the
+/// lens's intrinsics: `K⁻¹ H = λ [r1 r2 t]`, `C = −Rᵀ t` (Zhang 2000, §3.1).
+fn camera_centre(
+    table_to_pixel: &Homography,
+    lens: &pushbot_world::lens::Intrinsics,
+) -> Option<[f64; 3]> {
+    use nalgebra::{Matrix3, Vector3};
+    let h = &table_to_pixel.0;
+    let k = Matrix3::new(lens.fx, 0.0, lens.cx, 0.0, lens.fy, lens.cy, 0.0, 0.0, 1.0);
+    let m = k.try_inverse()? * Matrix3::from_fn(|i, j| h[i][j]);
+    let (m1, m2, m3) = (m.column(0), m.column(1), m.column(2));
+    let mut lambda = 2.0 / (m1.norm() + m2.norm());
+    if m3[2] * lambda < 0.0 {
+        lambda = -lambda;
+    }
+    let r1: Vector3<f64> = m1 * lambda;
+    let r2: Vector3<f64> = m2 * lambda;
+    let t: Vector3<f64> = m3 * lambda;
+    let r = Matrix3::from_columns(&[r1, r2, r1.cross(&r2)]);
+    let c = -(r.transpose() * t);
+    (c.iter().all(|v| v.is_finite()) && c[2] > 0.0).then_some([c[0], c[1], c[2]])
 }
 
 #[cfg(test)]
@@ -263,6 +308,7 @@ mod tests {
             centre: [0.4, 0.3],
             heading: 2.5,
             side: 0.05,
+            height: 0.0,
         };
         let (pose, side) = cal
             .marker_pose(&det(

@@ -37,6 +37,7 @@ impl FixedMarker {
             centre: self.centre,
             heading: self.heading,
             side: self.side,
+            height: 0.0,
         }
     }
 }
@@ -56,6 +57,9 @@ pub struct BodyMarker {
     /// The marker's pose in the body frame `[x, y, θ]` (metres, radians).
     #[serde(default)]
     pub offset: [f64; 3],
+    /// Height of the marker above the table, metres (the scene marker's `z`).
+    #[serde(default)]
+    pub height: f64,
 }
 
 impl BodyMarker {
@@ -73,6 +77,7 @@ impl BodyMarker {
             centre: [m.x, m.y],
             heading: m.theta,
             side: self.side,
+            height: self.height,
         }
     }
 
@@ -114,6 +119,7 @@ impl MarkerLayout {
             family: MarkerFamily::Tag36h11,
             side,
             offset,
+            height: 0.0,
         };
         MarkerLayout {
             table: [1.2, 0.9],
@@ -144,6 +150,7 @@ impl MarkerLayout {
             family: MarkerFamily::Tag36h11,
             side: m.size,
             offset: [m.x, m.y, 0.0],
+            height: m.z,
         };
         let mut bodies = vec![body("robot".into(), &scene.camera.robot_marker)];
         for o in &scene.objects {
@@ -263,6 +270,7 @@ mod tests {
             family: MarkerFamily::Tag36h11,
             side: 0.05,
             offset: [0.03, -0.02, 0.7],
+            height: 0.0,
         };
         let body = Pose::new(0.4, 0.3, -2.9);
         let m = b.placement(&body);

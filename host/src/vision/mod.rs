@@ -71,7 +71,7 @@ pub fn measure(dets: &[Detection], cal: &Calibration, layout: &MarkerLayout) -> 
         let Some(bm) = layout.body_marker(d.family, d.id) else {
             continue;
         };
-        let Some((marker_pose, side)) = cal.marker_pose(d) else {
+        let Some((marker_pose, side)) = cal.marker_pose_at(d, bm.height) else {
             continue;
         };
         if (side / bm.side - 1.0).abs() > SIDE_TOLERANCE {

@@ -186,6 +186,7 @@ impl Still {
                     && a.side == b.side
                     && close(a.centre, b.centre)
                     && (a.heading - b.heading).abs() <= EPS
+                    && (a.height - b.height).abs() <= EPS
             })
     }
 }
@@ -296,11 +297,22 @@ impl Camera {
         }
         let mut truth = Vec::with_capacity(markers.len());
         for m in markers {
+            // A raised marker is a plane of its own, in perspective through a known lens (an
+            // ideal camera's height is unknown: drawn flat).
+            let h_m = match &self.warp {
+                Some(w) => w.raised(&h_tp, m.height).ok_or_else(|| {
+                    CameraError::Invalid(format!("marker {} is above the camera", m.id))
+                })?,
+                None => h_tp,
+            };
+            canvas
+                .set_homography(h_m)
+                .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
             canvas
                 .marker(&self.codes, m, im.quiet_cells, n, im.ink[0], im.ink[1])
                 .map_err(CameraError::Invalid)?;
             let px = |p: [f64; 2]| {
-                let ideal = h_tp.apply(p).unwrap_or([f64::NAN; 2]);
+                let ideal = h_m.apply(p).unwrap_or([f64::NAN; 2]);
                 match &self.warp {
                     Some(w) => w.distort_pixel(ideal),
                     None => ideal,
@@ -372,6 +384,7 @@ mod tests {
             centre: [0.5, 0.4],
             heading: 0.2,
             side: 0.05,
+            height: 0.0,
         };
         let mut cam = Camera::new(cfg, 9).unwrap();
         let a = cam.capture(0.0, &[], &[m]).unwrap();
@@ -422,6 +435,7 @@ mod tests {
             centre: [0.6, 0.45],
             heading: 0.3,
             side: 0.05,
+            height: 0.0,
         };
         let a = Camera::new(cfg, 5)
             .unwrap()

@@ -107,6 +107,14 @@ impl Canvas {
         })
     }
 
+    /// See the table through another homography from now on (a marker raised above the table is
+    /// a plane of its own); `None` (and no change) if it is singular.
+    pub fn set_homography(&mut self, table_to_pixel: Homography) -> Option<()> {
+        self.pixel_to_table = table_to_pixel.inverse()?;
+        self.table_to_pixel = table_to_pixel;
+        Some(())
+    }
+
     /// Pixel bounding box (x0, y0, x1, y1 exclusive) of table points, clipped to the image.
     fn bbox(&self, pts: &[[f64; 2]]) -> Option<(usize, usize, usize, usize)> {
         let mut lo = [f64::INFINITY; 2];

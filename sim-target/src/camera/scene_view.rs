@@ -22,6 +22,7 @@ pub fn placement(m: &Marker, frame: &Pose) -> MarkerPlacement {
         centre: [frame.x + c * m.x - s * m.y, frame.y + s * m.x + c * m.y],
         heading: frame.theta,
         side: m.size,
+        height: m.z,
     }
 }
 
