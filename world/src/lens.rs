@@ -192,6 +192,16 @@ impl Intrinsics {
         self.distortion.invert(d)
     }
 
+    /// Where a pixel of an ideal lens with the same focal lengths and centre appears through
+    /// this one (the inverse of [`Intrinsics::undistort_pixel`]).
+    pub fn distort_pixel(&self, ideal: [f64; 2]) -> [f64; 2] {
+        let d = self.distortion.apply([
+            (ideal[0] - self.cx) / self.fx,
+            (ideal[1] - self.cy) / self.fy,
+        ]);
+        [self.fx * d[0] + self.cx, self.fy * d[1] + self.cy]
+    }
+
     /// Where a pixel would be through an ideal lens with the same focal lengths and centre.
     pub fn undistort_pixel(&self, px: [f64; 2]) -> Option<[f64; 2]> {
         let n = self.unproject(px)?;

@@ -235,7 +235,6 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
                 tracker: TrackerParams::default(),
                 detector: args.camera.detector,
                 whole_frames: args.whole_frames,
-                lens: None,
             };
             rec.begin_session(&info, 0)?;
             Some(rec)

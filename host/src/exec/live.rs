@@ -210,7 +210,6 @@ impl LiveRobot {
                 tracker: params,
                 detector: opts.detector,
                 whole_frames: false,
-                lens: lens.as_ref(),
             };
             crate::recording::live::LiveRecording::start(h, &robot, &info)
         });

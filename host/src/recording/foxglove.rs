@@ -54,15 +54,11 @@ pub fn image_data(msg: &Value) -> Option<Vec<u8>> {
 /// focal length from the homography's perspective part, or the image width for a camera
 /// looking straight down, where the homography cannot tell it), no distortion (the tracker
 /// works on the image as it is).
-pub fn camera_calibration(
-    ns: u64,
-    cal: &Calibration,
-    lens: Option<&pushbot_world::lens::Intrinsics>,
-) -> Value {
+pub fn camera_calibration(ns: u64, cal: &Calibration) -> Value {
     let [w, h] = cal.image_size;
     // A known lens is published as it is (its principal point moved to ROS's pixel centres at
     // integers); otherwise a pinhole read from the table homography.
-    let (k, d) = match lens {
+    let (k, d) = match &cal.lens {
         Some(l) => (
             [l.fx, 0.0, l.cx - 0.5, 0.0, l.fy, l.cy - 0.5, 0.0, 0.0, 1.0],
             l.distortion.to_array(),
@@ -333,7 +329,7 @@ mod tests {
     fn a_pinhole_is_read_from_the_homography() {
         // Straight down: no perspective, the focal length falls back to the image width.
         let down = calibration([[500.0, 0.0, 100.0], [0.0, -500.0, 600.0], [0.0, 0.0, 1.0]]);
-        assert_eq!(camera_calibration(0, &down, None)["K"][0], 960.0);
+        assert_eq!(camera_calibration(0, &down)["K"][0], 960.0);
         // H = K [r1 r2 t] of a camera with f = 800 tilted 20° about x, 1.5 m away.
         let (f, cx, cy) = (800.0, 480.0, 360.0);
         let (s, c) = 20f64.to_radians().sin_cos();
@@ -351,7 +347,7 @@ mod tests {
                 [a[1], b[1], tt[1]],
                 [a[2], b[2], tt[2]],
             ];
-            let got = camera_calibration(0, &calibration(h), None)["K"][0]
+            let got = camera_calibration(0, &calibration(h))["K"][0]
                 .as_f64()
                 .unwrap();
             assert!((got - f).abs() < 1e-6, "{got}");

@@ -101,8 +101,6 @@ fn start(v: &Value) -> Result<Live> {
     let tracker: TrackerParams = field(v, "tracker")?;
     let detector: DetectorKind = field(v, "detector")?;
     let scene: Option<pushbot_world::Scene> = field(v, "scene").ok();
-    // Recordings made before lenses were recorded have no "lens": an ideal pinhole.
-    let lens: Option<pushbot_world::lens::Intrinsics> = field(v, "lens").unwrap_or(None);
     let det = make_detector(detector, &layout.families())?;
     Ok(Live {
         info: SessionReplay {
@@ -121,11 +119,8 @@ fn start(v: &Value) -> Result<Live> {
             trace: Vec::new(),
         },
         pipeline: {
+            // A calibration made through a lens carries it: the pipeline measures through it.
             let p = Pipeline::new(det, layout, calibration, tracker);
-            let p = match lens {
-                Some(l) => p.with_lens(l),
-                None => p,
-            };
             if v.get("whole_frames").and_then(Value::as_bool) == Some(true) {
                 p.with_roi(crate::vision::RoiParams::full_frames())
             } else {

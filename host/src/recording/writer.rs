@@ -96,8 +96,6 @@ pub struct SessionInfo<'a> {
     pub detector: crate::vision::detect::DetectorKind,
     /// Whether every frame was searched whole (no regions of interest).
     pub whole_frames: bool,
-    /// The camera's lens, when detections are undistorted through one.
-    pub lens: Option<&'a pushbot_world::lens::Intrinsics>,
 }
 
 /// An MCAP file being written.
@@ -258,7 +256,6 @@ impl Recording {
             "tracker": info.tracker,
             "detector": info.detector,
             "whole_frames": info.whole_frames,
-            "lens": info.lens,
         });
         self.put(topics::SESSION, ns, &msg)?;
         if let Some(scene) = info.scene {
@@ -267,7 +264,7 @@ impl Recording {
         self.put(
             topics::CALIBRATION,
             ns,
-            &foxglove::camera_calibration(ns, info.calibration, info.lens),
+            &foxglove::camera_calibration(ns, info.calibration),
         )?;
         self.log_at(
             ns,

@@ -212,15 +212,6 @@ impl Pipeline {
         }
     }
 
-    /// The same pipeline for a camera with this lens: detected corners are undistorted before
-    /// they are measured (the calibration must have been fit on undistorted corners too; one
-    /// made by [`calibration::Calibration::fit_through`] carries its lens, which
-    /// [`Pipeline::new`] takes).
-    pub fn with_lens(mut self, lens: pushbot_world::lens::Intrinsics) -> Pipeline {
-        self.lens = Some(lens);
-        self
-    }
-
     /// Measure detections (raw pixels) through the lens, if there is one.
     fn measure_raw(&self, dets: &[Detection]) -> Vec<Measurement> {
         match &self.lens {

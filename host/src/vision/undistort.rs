@@ -62,12 +62,7 @@ mod tests {
             },
         };
         let ideal = [[100.0, 80.0], [140.0, 80.0], [140.0, 120.0], [100.0, 120.0]];
-        let distort = |p: [f64; 2]| {
-            let d = lens
-                .distortion
-                .apply([(p[0] - lens.cx) / lens.fx, (p[1] - lens.cy) / lens.fy]);
-            [lens.fx * d[0] + lens.cx, lens.fy * d[1] + lens.cy]
-        };
+        let distort = |p: [f64; 2]| lens.distort_pixel(p);
         let det = Detection {
             family: MarkerFamily::Tag36h11,
             id: 4,

@@ -70,11 +70,7 @@ impl LensWarp {
 
     /// Where an ideal pixel (the homography's) appears in the distorted image.
     pub fn distort_pixel(&self, ideal: [f64; 2]) -> [f64; 2] {
-        let l = &self.lens;
-        let d = l
-            .distortion
-            .apply([(ideal[0] - l.cx) / l.fx, (ideal[1] - l.cy) / l.fy]);
-        [l.fx * d[0] + l.cx, l.fy * d[1] + l.cy]
+        self.lens.distort_pixel(ideal)
     }
 
     /// The distorted image of an ideal one (`background` where the lens sees past it).
