@@ -50,6 +50,13 @@ if cargo tree -p pushbot --no-default-features -e normal --prefix none \
   echo "pushbot --no-default-features depends on the simulator or the firmware" >&2
   exit 1
 fi
+# Only the built-in target's own files name the simulator (at most three).
+sim_files=$(grep -rl pushbot_sim host/src | sort)
+echo "host files naming pushbot_sim:" $sim_files
+if [ "$(grep -c . <<<"$sim_files")" -gt 3 ] || grep -v '^host/src/sim/' <<<"$sim_files"; then
+  echo "more host files than the built-in target's name pushbot_sim" >&2
+  exit 1
+fi
 cargo clippy -p pushbot --no-default-features --lib --bins -- -D warnings
 cargo build -p pushbot --no-default-features
 set +e

@@ -3,7 +3,7 @@
 //!
 //! Every number is in robot (simulated) time except the wall time. What the robot executed is
 //! read from the simulator's own count of started primitives per sequence number
-//! ([`pushbot_sim::Sim::starts_since_boot`]: every session, as the host's numbering goes on
+//! (the simulator's `starts_since_boot`: every session, as the host's numbering goes on
 //! across recoveries), not from what the host believes:
 //!
 //! * `executed_twice`: motion commands the robot started more than once;
@@ -25,8 +25,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use pushbot_protocol::{Command, ConfigUpdate, Faults, Outcome};
-use pushbot_sim::faults::LinkFaults;
-use pushbot_sim::{Sim, SimOptions};
+use pushbot_world::Pose;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
@@ -34,6 +33,7 @@ use serde::Serialize;
 use crate::link::{Driver, LinkError};
 use crate::robot::{LinkOptions, Robot, command_name, link_broke, motion_budget_us};
 use crate::sim::inprocess::InProcess;
+use crate::sim::target::LinkFaults;
 
 /// What to run.
 #[derive(Debug, Clone, PartialEq)]
@@ -172,14 +172,6 @@ fn flip(sign: &mut f32) -> f32 {
 /// Run the bench.
 pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
     let wall = Instant::now();
-    let sim = Sim::new(&SimOptions {
-        seed: opts.seed,
-        speed: 0.0,
-        // A large empty table: the back-and-forth mix never reaches a wall.
-        table: (6.0, 6.0),
-        start: pushbot_sim::Pose::new(3.0, 3.0, 0.0),
-        ..SimOptions::default()
-    })?;
     let faults = LinkFaults {
         drop: opts.drop,
         corrupt: opts.corrupt,
@@ -193,8 +185,14 @@ pub fn run(opts: &LinkBenchOptions) -> Result<LinkBenchReport> {
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     rng.set_stream(7);
     let first_seq: u16 = rng.random();
-    let driver =
-        InProcess::with_faults(sim, opts.link.client_options(first_seq), faults, opts.seed);
+    // A large empty table: the back-and-forth mix never reaches a wall.
+    let driver = InProcess::on_open_table(
+        (6.0, 6.0),
+        Pose::new(3.0, 3.0, 0.0),
+        opts.seed,
+        faults,
+        opts.link.client_options(first_seq),
+    )?;
     let mut robot = Robot::over(driver, opts.link.clone())?;
     let now_us = |r: &Robot<InProcess>| r.driver().sim().now_us();
     let start_us = now_us(&robot);

@@ -107,6 +107,26 @@ impl InProcess {
         Ok(InProcess::new(sim, opts))
     }
 
+    /// The simulated robot alone on an empty `table` (metres, walls at its edges) at `start`,
+    /// every random draw from `seed`, its wire through a fault pipe with `faults` each way
+    /// (what `bench link` measures), driven with a client made with `opts`.
+    pub fn on_open_table(
+        table: (f64, f64),
+        start: pushbot_world::Pose,
+        seed: u64,
+        faults: LinkFaults,
+        opts: ClientOptions,
+    ) -> anyhow::Result<InProcess> {
+        let sim = Sim::new(&pushbot_sim::SimOptions {
+            seed,
+            speed: 0.0,
+            table,
+            start,
+            ..pushbot_sim::SimOptions::default()
+        })?;
+        Ok(InProcess::with_faults(sim, opts, faults, seed))
+    }
+
     /// Drive `sim` with a client made with `opts`, at the simulator's time.
     pub fn new(sim: Sim, opts: ClientOptions) -> InProcess {
         let client = Client::new(HostTime::from_micros(sim.now_us()), opts);
