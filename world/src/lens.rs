@@ -11,7 +11,7 @@
 //! strong barrel lenses too; it fails (`None`) rather than return a point that does not map
 //! back to the pixel.
 
-use nalgebra::{Isometry3, Point3};
+pub use crate::camera_pose::CameraPose;
 
 /// OpenCV's `plumb_bob` distortion coefficients, in OpenCV's order (k1, k2, p1, p2, k3).
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
@@ -149,6 +149,19 @@ pub struct Intrinsics {
 }
 
 impl Intrinsics {
+    /// An ideal pinhole for `width` × `height` frames with focal length `f` px, centred.
+    pub fn pinhole(width: u32, height: u32, f: f64) -> Intrinsics {
+        Intrinsics {
+            width,
+            height,
+            fx: f,
+            fy: f,
+            cx: f64::from(width) / 2.0,
+            cy: f64::from(height) / 2.0,
+            distortion: Distortion::NONE,
+        }
+    }
+
     /// What is wrong with these intrinsics for a camera, if anything.
     pub fn problem(&self) -> Option<String> {
         let finite = [self.fx, self.fy, self.cx, self.cy]
@@ -209,51 +222,6 @@ impl Intrinsics {
     }
 }
 
-/// Where the camera is: the table frame (x, y on the table, z up) seen from the camera
-/// frame (z along the optical axis, x right, y down in the image).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CameraPose {
-    /// Table frame → camera frame.
-    pub table_to_camera: Isometry3<f64>,
-}
-
-impl CameraPose {
-    /// A camera at `eye` (table frame, m) looking straight down, image x along table +x and
-    /// image y along table −y (the table appears as on a map).
-    pub fn overhead(eye: [f64; 3]) -> CameraPose {
-        let camera_to_table = Isometry3::from_parts(
-            nalgebra::Translation3::new(eye[0], eye[1], eye[2]),
-            nalgebra::UnitQuaternion::from_axis_angle(
-                &nalgebra::Vector3::x_axis(),
-                std::f64::consts::PI,
-            ),
-        );
-        CameraPose {
-            table_to_camera: camera_to_table.inverse(),
-        }
-    }
-
-    /// The pixel of a table point at height `z` (m), through `lens`.
-    pub fn project(&self, lens: &Intrinsics, p: [f64; 3]) -> Option<[f64; 2]> {
-        let c = self.table_to_camera * Point3::new(p[0], p[1], p[2]);
-        lens.project([c.x, c.y, c.z])
-    }
-
-    /// The table point at height `z` (m) seen at pixel `px` through `lens`: the ray through the
-    /// pixel met with the plane z = `z`; `None` when the ray misses it (parallel, or behind).
-    pub fn ray_to_plane(&self, lens: &Intrinsics, px: [f64; 2], z: f64) -> Option<[f64; 2]> {
-        let n = lens.unproject(px)?;
-        let to_table = self.table_to_camera.inverse();
-        let origin = to_table * Point3::origin();
-        let dir = to_table * nalgebra::Vector3::new(n[0], n[1], 1.0);
-        if dir.z.abs() < 1e-12 {
-            return None;
-        }
-        let t = (z - origin.z) / dir.z;
-        (t > 0.0).then(|| [origin.x + t * dir.x, origin.y + t * dir.y])
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,37 +275,6 @@ mod tests {
         assert!(r(d) < r(i) - 10.0, "barrel: {} vs {}", r(d), r(i));
         // On the optical axis nothing moves.
         assert_eq!(cam.project([0.0, 0.0, 1.0]), Some(centre));
-    }
-
-    #[test]
-    fn a_tilted_cameras_rays_meet_the_table_where_its_points_were() {
-        let cam = webcam();
-        let over = CameraPose::overhead([0.6, 0.45, 1.2]);
-        let tilt = nalgebra::UnitQuaternion::from_axis_angle(
-            &nalgebra::Vector3::x_axis(),
-            35f64.to_radians(),
-        );
-        let pose = CameraPose {
-            table_to_camera: Isometry3::from_parts(nalgebra::Translation3::identity(), tilt)
-                * over.table_to_camera,
-        };
-        for (x, y, z) in [
-            (0.6, 0.45, 0.0),
-            (0.3, 0.6, 0.06),
-            (0.9, 0.7, 0.03),
-            (0.5, 0.5, 0.0),
-        ] {
-            let px = pose.project(&cam, [x, y, z]).expect("seen");
-            let back = pose.ray_to_plane(&cam, px, z).expect("meets the plane");
-            assert!(
-                (back[0] - x).hypot(back[1] - y) < 1e-9,
-                "({x}, {y}, {z}) came back as {back:?}"
-            );
-        }
-        // The overhead camera sees table +x to the right and table +y up the image.
-        let a = over.project(&cam, [0.7, 0.45, 0.0]).unwrap();
-        let b = over.project(&cam, [0.6, 0.55, 0.0]).unwrap();
-        assert!(a[0] > cam.cx && b[1] < cam.cy, "{a:?} {b:?}");
     }
 
     #[test]

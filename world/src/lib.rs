@@ -7,7 +7,8 @@
 //! * [`scene`] — the one scene format (TOML), its validation with file:line:col errors, and
 //!   [`presets`];
 //! * [`camera`] — the camera model and the markers it sees;
-//! * [`lens`] — a real camera's intrinsics, `plumb_bob` distortion and pose over the table, and
+//! * [`lens`] — a real camera's intrinsics and `plumb_bob` distortion, [`camera_pose`] — its pose
+//!   over the table (any tilt) and the homographies of planes at a height, and
 //!   [`lens_file`] — the ROS and OpenCV intrinsics files, read and written;
 //! * [`workspace`] — the table and the boundary of a delivery (Lau et al. §III-A).
 //!
@@ -19,6 +20,7 @@
 
 pub mod body;
 pub mod camera;
+pub mod camera_pose;
 pub mod geometry;
 pub mod lens;
 pub mod lens_file;

@@ -181,7 +181,7 @@ impl LiveRobot {
             .with_context(|| format!("opening the camera {camera}"))?;
         let layout = MarkerLayout::from_scene(scene);
         let families = layout.families();
-        let lens = opts.lens.or(scene.camera.lens);
+        let lens = opts.lens.or(scene.camera.optics());
         let calibration = match &opts.calibration {
             Some(c) if lens.is_some() && c.lens != lens => bail!(
                 "the saved calibration was made {} the camera's lens: calibrate again with it",

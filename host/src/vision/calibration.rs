@@ -6,6 +6,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use pushbot_world::camera::Homography;
+use pushbot_world::camera_pose::CameraPose;
 use serde::{Deserialize, Serialize};
 
 use super::detection::Detection;
@@ -236,26 +237,12 @@ impl Calibration {
 }
 
 /// The camera's centre in the table frame from the table → ideal-pixel homography and the
-/// lens's intrinsics: `K⁻¹ H = λ [r1 r2 t]`, `C = −Rᵀ t` (Zhang 2000, §3.1).
+/// lens's intrinsics (Zhang's decomposition, [`CameraPose::from_homography`]).
 fn camera_centre(
     table_to_pixel: &Homography,
     lens: &pushbot_world::lens::Intrinsics,
 ) -> Option<[f64; 3]> {
-    use nalgebra::{Matrix3, Vector3};
-    let h = &table_to_pixel.0;
-    let k = Matrix3::new(lens.fx, 0.0, lens.cx, 0.0, lens.fy, lens.cy, 0.0, 0.0, 1.0);
-    let m = k.try_inverse()? * Matrix3::from_fn(|i, j| h[i][j]);
-    let (m1, m2, m3) = (m.column(0), m.column(1), m.column(2));
-    let mut lambda = 2.0 / (m1.norm() + m2.norm());
-    if m3[2] * lambda < 0.0 {
-        lambda = -lambda;
-    }
-    let r1: Vector3<f64> = m1 * lambda;
-    let r2: Vector3<f64> = m2 * lambda;
-    let t: Vector3<f64> = m3 * lambda;
-    let r = Matrix3::from_columns(&[r1, r2, r1.cross(&r2)]);
-    let c = -(r.transpose() * t);
-    (c.iter().all(|v| v.is_finite()) && c[2] > 0.0).then_some([c[0], c[1], c[2]])
+    CameraPose::from_homography(table_to_pixel, lens).map(|p| p.centre())
 }
 
 #[cfg(test)]

@@ -5,7 +5,6 @@
 //! `initUndistortRectifyMap` + `remap` do the other way round. Marker corners in the ground
 //! truth go through the same distortion.
 
-use pushbot_world::camera::Homography;
 use pushbot_world::lens::Intrinsics;
 
 /// Where each output pixel samples the ideal image (its index-space x, y; NaN: nowhere).
@@ -38,34 +37,6 @@ impl LensWarp {
             }
         }
         Ok(LensWarp { lens, map })
-    }
-
-    /// The homography of the plane `height` above the table, for a camera whose table homography
-    /// is `table`, looking straight down (the overhead model): the lens's focal length over the
-    /// table's scale in pixels per metre is the camera's height, and a raised plane is the table
-    /// scaled about the camera's nadir by `H / (H − height)`. `None` for a plane at or above the
-    /// camera.
-    pub fn raised(&self, table: &Homography, height: f64) -> Option<Homography> {
-        if height == 0.0 {
-            return Some(*table);
-        }
-        let to_table = table.inverse()?;
-        let l = &self.lens;
-        let nadir = to_table.apply([l.cx, l.cy])?;
-        let a = table.apply(nadir)?;
-        let b = table.apply([nadir[0] + 0.01, nadir[1]])?;
-        let px_per_m = (b[0] - a[0]).hypot(b[1] - a[1]) / 0.01;
-        let camera_height = l.fx / px_per_m;
-        if height >= camera_height {
-            return None;
-        }
-        let k = camera_height / (camera_height - height);
-        let scale = Homography([
-            [k, 0.0, (1.0 - k) * nadir[0]],
-            [0.0, k, (1.0 - k) * nadir[1]],
-            [0.0, 0.0, 1.0],
-        ]);
-        Some(table.compose(&scale))
     }
 
     /// Where an ideal pixel (the homography's) appears in the distorted image.

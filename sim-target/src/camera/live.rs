@@ -63,6 +63,7 @@ impl LiveCamera {
         opts: &LiveCameraOptions,
         view: WorldView,
     ) -> Result<LiveCamera> {
+        let (wheel_radius, wheel_base) = (scene.robot.wheel_radius, scene.robot.wheel_base);
         let mut camera = SceneCamera::new(scene, seed ^ 0x00CA_3E4A)
             .context("setting up the simulated camera")?;
         let server = CameraServer::bind(opts.addr.as_str())
@@ -95,7 +96,13 @@ impl LiveCamera {
                         continue;
                     }
                     let objects = lock(&view.objects).clone();
-                    let frame = camera.capture(truth.t, &truth.pose, &objects)?;
+                    // The robot's true motion, for the smear over the exposure.
+                    let [wl, wr] = truth.wheel_speed;
+                    let twist = [
+                        wheel_radius * (wl + wr) / 2.0,
+                        wheel_radius * (wr - wl) / wheel_base,
+                    ];
+                    let frame = camera.capture_moving(truth.t, &truth.pose, twist, &objects)?;
                     server.publish(&frame);
                     if let Some(dir) = &frames_dir {
                         frame.write_png(dir)?;

@@ -7,6 +7,7 @@
 //! the table and its exact corners in pixels (pixel centres at `i + 0.5`). Frames can be written
 //! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
 
+pub mod draw;
 pub mod families;
 pub mod lens;
 pub mod live;
@@ -20,10 +21,12 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+pub use draw::{Overlay, View};
 pub use render::{Homography, MarkerFamily, MarkerPlacement, Polygon, TagCodes};
 pub use scene_view::{SceneCamera, scene_view};
 
 pub use pushbot_world::camera::{CameraModel, MarkerTruth};
+use pushbot_world::camera_pose::CameraPose;
 
 /// Optics and sensor of the simulated camera.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -79,7 +82,9 @@ pub struct CameraConfig {
     /// Table size (metres), drawn as a rectangle from (0, 0).
     pub table: [f64; 2],
     /// A real lens: the image is drawn through `model` (the ideal pinhole) and then distorted
-    /// by these intrinsics, made for the same image size ([`lens::LensWarp`]).
+    /// by these intrinsics, made for the same image size ([`lens::LensWarp`]); with it the
+    /// camera knows its place over the table (from `model` and the focal lengths), so what is
+    /// at a height is drawn in perspective.
     pub lens: Option<pushbot_world::lens::Intrinsics>,
 }
 
@@ -153,8 +158,10 @@ pub struct Camera {
     /// The last scene drawn and its blurred irradiance: a frame of a scene that has not moved
     /// (the robot waiting for its host) differs from it only by the sensor's fresh noise.
     still: Option<Still>,
-    /// The lens's warp, when the configuration has a lens.
+    /// The lens's warp, when the configuration has a lens that distorts.
     warp: Option<lens::LensWarp>,
+    /// Where the camera is over the table, when the configuration has a lens.
+    pose: Option<CameraPose>,
 }
 
 /// A drawn scene: what was drawn, the blurred irradiance, the markers' ground truth.
@@ -162,6 +169,7 @@ pub struct Camera {
 struct Still {
     polygons: Vec<Polygon>,
     markers: Vec<MarkerPlacement>,
+    overlays: Vec<Overlay>,
     irradiance: Vec<f32>,
     truth: Vec<MarkerTruth>,
 }
@@ -169,11 +177,12 @@ struct Still {
 impl Still {
     /// Whether `polygons` and `markers` draw the same image as this still (every coordinate
     /// within a micrometre, a thousandth of a pixel or less).
-    fn same(&self, polygons: &[Polygon], markers: &[MarkerPlacement]) -> bool {
+    fn same(&self, polygons: &[Polygon], markers: &[MarkerPlacement], overlays: &[Overlay]) -> bool {
         const EPS: f64 = 1e-6;
         let close =
             |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() <= EPS && (a[1] - b[1]).abs() <= EPS;
-        self.polygons.len() == polygons.len()
+        self.overlays == overlays
+            && self.polygons.len() == polygons.len()
             && self.markers.len() == markers.len()
             && self.polygons.iter().zip(polygons).all(|(a, b)| {
                 a.shade == b.shade
@@ -207,15 +216,31 @@ impl Camera {
                 "frame rate and image size must be positive".into(),
             ));
         }
+        if let Some(l) = &config.lens
+            && let Some(p) = l.problem()
+        {
+            return Err(CameraError::Invalid(format!("lens: {p}")));
+        }
+        // A lens that distorts warps the image; any lens (an ideal one too) gives the camera's
+        // place over the table, so markers and occluders at a height are drawn in perspective.
         let warp = match config.lens {
-            Some(l) => Some(
+            Some(l) if !l.distortion.is_none() => Some(
                 lens::LensWarp::new(l, config.model.width, config.model.height)
                     .map_err(CameraError::Invalid)?,
             ),
-            None => None,
+            _ => None,
         };
+        let pose = config
+            .lens
+            .and_then(|l| CameraPose::from_homography(&config.model.table_to_pixel, &l));
+        if config.lens.is_some() && pose.is_none() {
+            return Err(CameraError::Invalid(
+                "the table homography is not a camera seeing the table through this lens".into(),
+            ));
+        }
         Ok(Camera {
             warp,
+            pose,
             config,
             codes: TagCodes::new().map_err(CameraError::Invalid)?,
             rng: ChaCha8Rng::seed_from_u64(seed),
@@ -241,12 +266,22 @@ impl Camera {
         polygons: &[Polygon],
         markers: &[MarkerPlacement],
     ) -> Result<CameraFrame, CameraError> {
-        if !self
-            .still
-            .as_ref()
-            .is_some_and(|s| s.same(polygons, markers))
-        {
-            self.still = Some(self.draw(polygons, markers)?);
+        self.capture_exposure(time, &[View { polygons, markers }], &[])
+    }
+
+    /// Render the next frame at simulated `time` from `views` of the scene spread evenly over
+    /// the exposure (one: an instant; more: what moved between them smears), with `overlays`
+    /// (things between the camera and the table, at their heights) drawn over everything. The
+    /// ground truth is the middle view's.
+    pub fn capture_exposure(
+        &mut self,
+        time: f64,
+        views: &[View<'_>],
+        overlays: &[Overlay],
+    ) -> Result<CameraFrame, CameraError> {
+        let still = matches!(views, [v] if self.still.as_ref().is_some_and(|s| s.same(v.polygons, v.markers, overlays)));
+        if !still {
+            self.still = Some(self.draw(views, overlays)?);
         }
         let Some(still) = &self.still else {
             return Err(CameraError::Invalid("no image drawn".into()));
@@ -271,84 +306,6 @@ impl Camera {
         };
         self.seq += 1;
         Ok(frame)
-    }
-
-    /// Draw the table, `polygons` and `markers` and blur them as the lens does.
-    fn draw(
-        &self,
-        polygons: &[Polygon],
-        markers: &[MarkerPlacement],
-    ) -> Result<Still, CameraError> {
-        let cfg = &self.config;
-        let im = &cfg.imaging;
-        let (w, h) = (cfg.model.width as usize, cfg.model.height as usize);
-        let h_tp = cfg.model.table_to_pixel;
-        let mut canvas = render::Canvas::new(w, h, h_tp, im.floor_shade)
-            .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
-        let n = im.supersample.max(1);
-        let [tw, th] = cfg.table;
-        let table = Polygon {
-            points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]],
-            shade: im.table_shade,
-        };
-        canvas.polygon(&table, n);
-        for p in polygons {
-            canvas.polygon(p, n);
-        }
-        let mut truth = Vec::with_capacity(markers.len());
-        for m in markers {
-            // A raised marker is a plane of its own, in perspective through a known lens (an
-            // ideal camera's height is unknown: drawn flat).
-            let h_m = match &self.warp {
-                Some(w) => w.raised(&h_tp, m.height).ok_or_else(|| {
-                    CameraError::Invalid(format!("marker {} is above the camera", m.id))
-                })?,
-                None => h_tp,
-            };
-            canvas
-                .set_homography(h_m)
-                .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
-            canvas
-                .marker(&self.codes, m, im.quiet_cells, n, im.ink[0], im.ink[1])
-                .map_err(CameraError::Invalid)?;
-            let px = |p: [f64; 2]| {
-                let ideal = h_m.apply(p).unwrap_or([f64::NAN; 2]);
-                match &self.warp {
-                    Some(w) => w.distort_pixel(ideal),
-                    None => ideal,
-                }
-            };
-            let (_, tw, wab) = self
-                .codes
-                .pattern(m.family, m.id)
-                .ok_or_else(|| CameraError::Invalid("bad id".into()))?;
-            let outer_side = m.side * (tw as f64 + 2.0 * im.quiet_cells) / wab as f64;
-            let outer = MarkerPlacement {
-                side: outer_side,
-                ..*m
-            };
-            let fully_visible = outer.corners().iter().all(|&p| {
-                let q = px(p);
-                q[0] >= 1.0 && q[1] >= 1.0 && q[0] <= w as f64 - 1.0 && q[1] <= h as f64 - 1.0
-            });
-            truth.push(MarkerTruth {
-                marker: *m,
-                corners_px: m.corners().map(px),
-                centre_px: px(m.centre),
-                fully_visible,
-            });
-        }
-        render::gaussian_blur(&mut canvas.data, w, h, im.blur_sigma_px);
-        let irradiance = match &self.warp {
-            Some(warp) => warp.apply(&canvas.data, w, h, im.floor_shade as f32),
-            None => canvas.data,
-        };
-        Ok(Still {
-            polygons: polygons.to_vec(),
-            markers: markers.to_vec(),
-            irradiance,
-            truth,
-        })
     }
 }
 

@@ -6,12 +6,14 @@ use crate::robot::Pose;
 use crate::scene::{Marker, Scene, placed};
 
 use super::{Camera, CameraConfig, CameraError, CameraFrame, CameraModel, Imaging};
-use super::{MarkerFamily, MarkerPlacement, Polygon};
+use super::{MarkerFamily, MarkerPlacement, Overlay, Polygon, View};
 
 /// Reflectance of obstacles (dark), objects (light grey) and the robot's body (dark grey).
 const OBSTACLE_SHADE: f64 = 0.12;
 const OBJECT_SHADE: f64 = 0.8;
 const ROBOT_SHADE: f64 = 0.3;
+/// Reflectance of an occluder (a hand).
+const OCCLUDER_SHADE: f64 = 0.35;
 
 /// A marker printed in a frame at `frame`: its placement on the table.
 pub fn placement(m: &Marker, frame: &Pose) -> MarkerPlacement {
@@ -77,18 +79,37 @@ pub fn scene_view(
     (polygons, markers)
 }
 
-/// The camera a scene asks for: its image size and frame rate, straight above the table.
+/// The camera a scene asks for: its image size and frame rate, straight above the table with
+/// the table filling the image, or where its `pose` puts it; through its lens, if it has one.
 pub fn scene_camera_config(scene: &Scene, imaging: Imaging) -> CameraConfig {
     let table = [scene.table.width, scene.table.height];
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let optics = scene.camera.optics();
+    let placed = scene
+        .camera
+        .pose
+        .and_then(|p| p.pose())
+        .zip(optics)
+        .and_then(|(pose, lens)| pose.plane_homography(&lens, 0.0));
     CameraConfig {
-        model: CameraModel::overhead(table, scene.camera.width, scene.camera.height, 16.0),
+        model: match placed {
+            Some(table_to_pixel) => CameraModel {
+                width: w,
+                height: h,
+                table_to_pixel,
+            },
+            None => CameraModel::overhead(table, w, h, 16.0),
+        },
         imaging,
         fps: scene.camera.fps,
         table,
-        // The lens of the scene's `camera.intrinsics` file, if it has one (read with the scene).
-        lens: scene.camera.lens,
+        // The lens of the scene's `camera.intrinsics` file, or a placed camera's ideal one.
+        lens: optics,
     }
 }
+
+/// Most views drawn over one exposure.
+const MAX_VIEWS: usize = 15;
 
 /// A camera looking at a scene.
 #[derive(Debug, Clone)]
@@ -119,9 +140,89 @@ impl SceneCamera {
         robot: &Pose,
         objects: &[(String, Pose)],
     ) -> Result<CameraFrame, CameraError> {
-        let (polygons, markers) = scene_view(&self.scene, robot, objects);
-        self.camera.capture(time, &polygons, &markers)
+        self.capture_moving(time, robot, [0.0, 0.0], objects)
     }
+
+    /// Render the scene at simulated `time` (the middle of the exposure) with the robot at
+    /// `robot` moving at `twist` (forward m/s, turning rad/s) and the objects where they are:
+    /// with the scene's `camera.exposure`, the robot is drawn along its arc over the exposure,
+    /// enough views that no point of it moves more than half a pixel between two (at most
+    /// 15), and the views averaged; the scene's occluders shown at `time` are drawn on top.
+    pub fn capture_moving(
+        &mut self,
+        time: f64,
+        robot: &Pose,
+        twist: [f64; 2],
+        objects: &[(String, Pose)],
+    ) -> Result<CameraFrame, CameraError> {
+        let exposure = self.scene.camera.exposure;
+        let reach = self.scene.robot.bumper_radius.max(
+            self.scene.camera.robot_marker.x.hypot(self.scene.camera.robot_marker.y)
+                + self.scene.camera.robot_marker.size,
+        );
+        let travel_m = (twist[0].abs() + twist[1].abs() * reach) * exposure;
+        let px = travel_m * self.pixels_per_metre();
+        let n = if px.is_finite() && px > 0.5 {
+            ((2.0 * px).ceil() as usize).clamp(2, MAX_VIEWS) | 1
+        } else {
+            1
+        };
+        let drawn: Vec<_> = (0..n)
+            .map(|k| {
+                let s = if n == 1 {
+                    0.0
+                } else {
+                    exposure * (k as f64 / (n - 1) as f64 - 0.5)
+                };
+                scene_view(&self.scene, &along_arc(robot, twist, s), objects)
+            })
+            .collect();
+        let views: Vec<View<'_>> = drawn
+            .iter()
+            .map(|(polygons, markers)| View { polygons, markers })
+            .collect();
+        let overlays: Vec<Overlay> = self
+            .scene
+            .camera
+            .occluders
+            .iter()
+            .filter(|o| o.shown_at(time))
+            .map(|o| Overlay {
+                polygon: Polygon {
+                    points: o.outline.clone(),
+                    shade: OCCLUDER_SHADE,
+                },
+                height: o.z,
+            })
+            .collect();
+        self.camera.capture_exposure(time, &views, &overlays)
+    }
+
+    /// The image's scale at the table's centre, pixels per metre.
+    fn pixels_per_metre(&self) -> f64 {
+        let h = self.camera.config().model.table_to_pixel;
+        let c = [self.scene.table.width / 2.0, self.scene.table.height / 2.0];
+        match (h.apply(c), h.apply([c[0] + 0.01, c[1]])) {
+            (Some(a), Some(b)) => (b[0] - a[0]).hypot(b[1] - a[1]) / 0.01,
+            _ => 0.0,
+        }
+    }
+}
+
+/// Where a robot at `pose` moving at `twist` (forward m/s, turning rad/s) is `s` seconds later
+/// (earlier for negative `s`), along its arc.
+pub fn along_arc(pose: &Pose, twist: [f64; 2], s: f64) -> Pose {
+    let [v, w] = twist;
+    let th = pose.theta + w * s;
+    if w.abs() < 1e-9 {
+        let (sn, c) = pose.theta.sin_cos();
+        return Pose::new(pose.x + v * s * c, pose.y + v * s * sn, th);
+    }
+    Pose::new(
+        pose.x + v / w * (th.sin() - pose.theta.sin()),
+        pose.y - v / w * (th.cos() - pose.theta.cos()),
+        th,
+    )
 }
 
 #[cfg(test)]

@@ -12,7 +12,14 @@
 //! # ids 40–45, 6 cm in from the four corners and the middles of the long edges
 //! fiducials = [{ id = 40, x = 0.06, y = 0.06, size = 0.05 }]
 //! intrinsics = "camera.yaml"  # lens model (ROS camera_info or OpenCV YAML), relative to the scene file
+//! pose = { eye = [0.6, -0.3, 1.0], look_at = [0.6, 0.45, 0.0] }  # default: straight above
+//! exposure = 0.033             # seconds the shutter is open: moving markers smear (default 0)
+//! # things between the camera and the table (a hand), drawn over everything while shown
+//! occluders = [{ outline = [[0.5, 0.3], [0.7, 0.3], [0.7, 0.5]], z = 0.3, from = 2.0, until = 4.0 }]
 //! ```
+//!
+//! A camera with a `pose` but no `intrinsics` is an ideal pinhole with a focal length of 0.73 ×
+//! the image width (a 68° horizontal field of view, a typical webcam's).
 
 use serde::{Deserialize, Serialize};
 
@@ -44,6 +51,44 @@ pub struct CameraSpec {
     /// `height`; `None`: an ideal pinhole.
     #[serde(skip)]
     pub lens: Option<crate::lens::Intrinsics>,
+    /// Where the camera is; `None`: straight above the table's centre, the table filling the
+    /// image (the lens's focal length then sets its height).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose: Option<crate::camera_pose::CameraPlacement>,
+    /// Seconds the shutter is open for each frame: what moves in that time smears.
+    pub exposure: f64,
+    /// Things between the camera and the table, drawn over everything while shown.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub occluders: Vec<Occluder>,
+}
+
+/// Something between the camera and the table (a hand, an arm): a dark polygon at a height,
+/// shown from `from` until `until` seconds of simulated time.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Occluder {
+    /// Outline in table metres (x, y), on the plane `z`.
+    pub outline: Vec<[f64; 2]>,
+    /// Height above the table, metres.
+    #[serde(default)]
+    pub z: f64,
+    /// First moment shown, seconds.
+    #[serde(default)]
+    pub from: f64,
+    /// Last moment shown, seconds (default: for ever).
+    #[serde(default = "forever")]
+    pub until: f64,
+}
+
+fn forever() -> f64 {
+    f64::INFINITY
+}
+
+impl Occluder {
+    /// Whether the occluder is there at `time`.
+    pub fn shown_at(&self, time: f64) -> bool {
+        (self.from..=self.until).contains(&time)
+    }
 }
 
 impl Default for CameraSpec {
@@ -62,11 +107,24 @@ impl Default for CameraSpec {
             fiducials: None,
             intrinsics: None,
             lens: None,
+            pose: None,
+            exposure: 0.0,
+            occluders: Vec::new(),
         }
     }
 }
 
 impl CameraSpec {
+    /// The lens the camera draws through: the scene's intrinsics, or — for a camera placed by
+    /// `pose` without them — an ideal pinhole with a focal length of 0.73 × the image width.
+    pub fn optics(&self) -> Option<crate::lens::Intrinsics> {
+        self.lens.or_else(|| {
+            self.pose.map(|_| {
+                crate::lens::Intrinsics::pinhole(self.width, self.height, 0.73 * f64::from(self.width))
+            })
+        })
+    }
+
     /// The calibration markers on a `width × height` m table: the ones given, or six 5 cm tags
     /// (ids 40–45) 6 cm in from the corners and the middles of the long edges.
     pub fn fiducials_on(&self, width: f64, height: f64) -> Vec<Marker> {

@@ -51,7 +51,7 @@ mod checks;
 mod error;
 mod sections;
 mod validate;
-pub use camera::CameraSpec;
+pub use camera::{CameraSpec, Occluder};
 pub use error::SceneError;
 use error::{Seg, key_before, line_col, path_string, span_of};
 pub mod rearrange;

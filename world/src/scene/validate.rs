@@ -196,6 +196,28 @@ impl Scene {
                 "must be a frame rate in (0, 1000]",
             ));
         }
+        if let Some(p) = c.pose.and_then(|p| p.problem()) {
+            return Err(invalid(vec![Key("camera"), Key("pose")], p));
+        }
+        if !(c.exposure.is_finite() && (0.0..=1.0 / c.fps).contains(&c.exposure)) {
+            return Err(invalid(
+                vec![Key("camera"), Key("exposure")],
+                format!(
+                    "must be a time in seconds from 0 to the frame period ({:.4} s)",
+                    1.0 / c.fps
+                ),
+            ));
+        }
+        for (i, o) in c.occluders.iter().enumerate() {
+            let at = |k| vec![Key("camera"), Key("occluders"), Index(i), Key(k)];
+            check_polygon(&o.outline).map_err(|m| invalid(at("outline"), m))?;
+            if !(o.z.is_finite() && o.z >= 0.0) {
+                return Err(invalid(at("z"), "must be a height of 0 m or more"));
+            }
+            if o.from.is_nan() || o.until.is_nan() || o.until < o.from {
+                return Err(invalid(at("until"), "must not come before `from`"));
+            }
+        }
         let drawable = |m: &Marker| marker_ok(m).is_ok();
         let mut used: Vec<(u32, Vec<Seg>)> = Vec::new();
         let mut add = |id: u32, path: Vec<Seg>| -> Result<(), Invalid> {
