@@ -229,7 +229,10 @@ mod tests {
         let e = pose.project(&cam, [0.7, 0.45, 0.0]).unwrap();
         assert!((c[0] - cam.cx).abs() < 1e-6, "{c:?}");
         assert!(d[1] < c[1] && e[0] > c[0], "{c:?} {d:?} {e:?}");
-        assert_eq!(over.centre().map(|v| (v * 1e9).round()), [0.6e9, 0.45e9, 1.2e9]);
+        assert_eq!(
+            over.centre().map(|v| (v * 1e9).round()),
+            [0.6e9, 0.45e9, 1.2e9]
+        );
     }
 
     /// A plane's homography agrees with projecting its points, and the pose comes back from
@@ -256,7 +259,10 @@ mod tests {
             assert!(d < 1e-9, "{c0:?} vs {c1:?}");
             let raised = back.plane_homography(&lens, 0.06).unwrap();
             let want = pose.plane_homography(&lens, 0.06).unwrap();
-            let (a, b) = (raised.apply([0.3, 0.7]).unwrap(), want.apply([0.3, 0.7]).unwrap());
+            let (a, b) = (
+                raised.apply([0.3, 0.7]).unwrap(),
+                want.apply([0.3, 0.7]).unwrap(),
+            );
             assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6, "{a:?} {b:?}");
         }
     }

@@ -130,7 +130,10 @@ fn calibrate_from(
             break;
         };
         size = [frame.width, frame.height];
-        all.push(det.detect(&frame).map_err(|e| CliError::Failed(e.into()))?);
+        all.push(
+            det.detect_fine(&frame)
+                .map_err(|e| CliError::Failed(e.into()))?,
+        );
     }
     if all.is_empty() {
         return Err(CliError::bad_input(format!(

@@ -477,7 +477,7 @@ fn calibrate(
         let (n, frame) = grabber.next_after(after, timeout)?;
         after = n;
         size = [frame.width, frame.height];
-        frames.push(det.detect(&frame)?);
+        frames.push(det.detect_fine(&frame)?);
     }
     Calibration::fit_through(&frames, layout, size, lens.as_ref()).context("calibrating the camera")
 }

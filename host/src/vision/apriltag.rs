@@ -59,6 +59,8 @@ impl AprilTagCConfig {
 /// The C detector: one C detector per family, so every detection's family is known.
 pub struct AprilTagC {
     detectors: Vec<(MarkerFamily, CDetector)>,
+    /// The same families finding quads at full resolution (small or far markers).
+    fine: Vec<(MarkerFamily, CDetector)>,
     /// Aligned image buffers, one per region size in use (the full frame, the crops).
     images: Vec<Image>,
 }
@@ -80,6 +82,25 @@ impl std::fmt::Debug for AprilTagC {
 impl AprilTagC {
     /// A detector for these families.
     pub fn new(families: &[MarkerFamily], cfg: &AprilTagCConfig) -> Result<AprilTagC, DetectError> {
+        // Small markers need every pixel: no decimation, and no blur before the quads are
+        // found (σ = 1 px erases a 20-pixel tag's cells).
+        let fine = AprilTagCConfig {
+            decimate: 1.0,
+            sigma: 0.0,
+            ..*cfg
+        };
+        Ok(AprilTagC {
+            detectors: Self::build(families, cfg)?,
+            fine: Self::build(families, &fine)?,
+            images: Vec::new(),
+        })
+    }
+
+    /// One C detector per family with these settings.
+    fn build(
+        families: &[MarkerFamily],
+        cfg: &AprilTagCConfig,
+    ) -> Result<Vec<(MarkerFamily, CDetector)>, DetectError> {
         let mut detectors = Vec::new();
         for &fam in families {
             let builder = DetectorBuilder::new();
@@ -98,28 +119,17 @@ impl AprilTagC {
             d.set_thread_number(cfg.threads.max(1));
             detectors.push((fam, d));
         }
-        Ok(AprilTagC {
-            detectors,
-            images: Vec::new(),
-        })
-    }
-}
-
-impl Detector for AprilTagC {
-    fn name(&self) -> &'static str {
-        "apriltag-c"
+        Ok(detectors)
     }
 
-    fn detect(&mut self, frame: &Frame) -> Result<Vec<Detection>, DetectError> {
-        self.detect_region(frame, Region::full(frame.width, frame.height))
-    }
-
-    /// Copies only the region's rows into a reused, aligned buffer of the region's size (no
-    /// allocation once the few sizes in use have been seen).
-    fn detect_region(
+    /// Detect in `region` with the decimated detectors or the `fine` ones. Copies only the
+    /// region's rows into a reused, aligned buffer of the region's size (no allocation once the
+    /// few sizes in use have been seen).
+    fn run(
         &mut self,
         frame: &Frame,
         region: Region,
+        fine: bool,
     ) -> Result<Vec<Detection>, DetectError> {
         check(frame, &region)?;
         let (w, h) = (region.width as usize, region.height as usize);
@@ -149,7 +159,12 @@ impl Detector for AprilTagC {
         }
         let (dx, dy) = (region.x as f64, region.y as f64);
         let mut out = Vec::new();
-        for (fam, det) in &mut self.detectors {
+        let detectors = if fine {
+            &mut self.fine
+        } else {
+            &mut self.detectors
+        };
+        for (fam, det) in detectors {
             for d in det.detect(image) {
                 // The library's corners are H·(−1, 1), H·(1, 1), H·(1, −1), H·(−1, −1) in tag
                 // coordinates with y down the printed tag: bottom-left, bottom-right, top-right,
@@ -166,5 +181,31 @@ impl Detector for AprilTagC {
             }
         }
         Ok(out)
+    }
+}
+
+impl Detector for AprilTagC {
+    fn name(&self) -> &'static str {
+        "apriltag-c"
+    }
+
+    fn detect(&mut self, frame: &Frame) -> Result<Vec<Detection>, DetectError> {
+        self.run(frame, Region::full(frame.width, frame.height), false)
+    }
+
+    fn detect_region(
+        &mut self,
+        frame: &Frame,
+        region: Region,
+    ) -> Result<Vec<Detection>, DetectError> {
+        self.run(frame, region, false)
+    }
+
+    fn detect_region_fine(
+        &mut self,
+        frame: &Frame,
+        region: Region,
+    ) -> Result<Vec<Detection>, DetectError> {
+        self.run(frame, region, true)
     }
 }

@@ -145,6 +145,21 @@ pub trait Detector {
             .map(|d| d.shifted(dx, dy))
             .collect())
     }
+    /// As [`Detector::detect_region`], searching harder for small markers (for the C library:
+    /// quads found at full resolution rather than decimated): for calibration, where time does
+    /// not matter, and for a second look where a body was expected and not found. The default
+    /// is the same search.
+    fn detect_region_fine(
+        &mut self,
+        frame: &Frame,
+        region: Region,
+    ) -> Result<Vec<Detection>, DetectError> {
+        self.detect_region(frame, region)
+    }
+    /// The whole frame, searched as [`Detector::detect_region_fine`] does.
+    fn detect_fine(&mut self, frame: &Frame) -> Result<Vec<Detection>, DetectError> {
+        self.detect_region_fine(frame, Region::full(frame.width, frame.height))
+    }
 }
 
 /// Why detection could not run.

@@ -175,7 +175,12 @@ pub struct Pipeline {
     sightings: Vec<(String, Sighting)>,
     /// The camera's lens: detections are undistorted before they are measured.
     lens: Option<pushbot_world::lens::Intrinsics>,
+    /// Time of the last whole-frame search at full resolution.
+    last_fine: Option<f64>,
 }
+
+/// Seconds between whole-frame searches at full resolution while a body is not found.
+const FINE_EVERY: f64 = 0.5;
 
 impl std::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -209,6 +214,7 @@ impl Pipeline {
             since_full: 0,
             sightings: Vec::new(),
             lens,
+            last_fine: None,
         }
     }
 
@@ -274,8 +280,17 @@ impl Pipeline {
     ) -> Result<(Vec<Detection>, Vec<Measurement>, bool), DetectError> {
         if let Some(regions) = self.regions(frame) {
             let mut dets: Vec<Detection> = Vec::new();
-            for r in regions {
-                for d in self.detector.detect_region(frame, r)? {
+            let names: Vec<String> = self.sightings.iter().map(|(b, _)| b.clone()).collect();
+            for (r, body) in regions.into_iter().zip(&names) {
+                let mut found = self.detector.detect_region(frame, r)?;
+                // A marker too small for the decimated search: look again at full resolution.
+                let want = self.layout.bodies.iter().find(|b| &b.body == body);
+                if let Some(b) = want
+                    && !found.iter().any(|d| d.family == b.family && d.id == b.id)
+                {
+                    found = self.detector.detect_region_fine(frame, r)?;
+                }
+                for d in found {
                     // Overlapping regions find the same marker twice: keep one.
                     let dup = dets.iter().any(|e| {
                         e.family == d.family
@@ -297,8 +312,28 @@ impl Pipeline {
                 return Ok((dets, ms, false));
             }
         }
-        let dets = self.detector.detect(frame)?;
-        let ms = self.measure_raw(&dets);
+        let mut dets = self.detector.detect(frame)?;
+        let mut ms = self.measure_raw(&dets);
+        // A body of the layout not found: search the whole frame at full resolution too (its
+        // marker may be small or far), at most every FINE_EVERY seconds.
+        let missing = self
+            .layout
+            .bodies
+            .iter()
+            .any(|b| !ms.iter().any(|m| m.body == b.body));
+        if missing
+            && self
+                .last_fine
+                .is_none_or(|t| !(0.0..FINE_EVERY).contains(&(frame.time - t)))
+        {
+            self.last_fine = Some(frame.time);
+            for d in self.detector.detect_fine(frame)? {
+                if !dets.iter().any(|e| e.family == d.family && e.id == d.id) {
+                    dets.push(d);
+                }
+            }
+            ms = self.measure_raw(&dets);
+        }
         self.since_full = 0;
         Ok((dets, ms, true))
     }

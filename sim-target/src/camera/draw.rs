@@ -46,7 +46,7 @@ impl Camera {
     /// Draw marker `m` on `canvas`, on its own plane.
     fn draw_marker(&self, canvas: &mut Canvas, m: &MarkerPlacement) -> Result<(), CameraError> {
         let im = &self.config.imaging;
-        let plane = self.plane(m.height, &format!("marker {}", m.id))?;
+        let plane = self.to_canvas(self.plane(m.height, &format!("marker {}", m.id))?);
         canvas
             .set_homography(plane)
             .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
@@ -60,8 +60,31 @@ impl Camera {
                 im.ink[1],
             )
             .map_err(CameraError::Invalid)?;
-        canvas.set_homography(self.config.model.table_to_pixel);
+        canvas.set_homography(self.to_canvas(self.config.model.table_to_pixel));
         Ok(())
+    }
+
+    /// The ideal image's size: the frame's, or the lens warp's larger one.
+    fn canvas_size(&self) -> (usize, usize) {
+        match &self.warp {
+            Some(w) => (w.ideal_size()[0], w.ideal_size()[1]),
+            None => (
+                self.config.model.width as usize,
+                self.config.model.height as usize,
+            ),
+        }
+    }
+
+    /// A homography to ideal pixels, made to draw on the ideal image (whose origin a lens
+    /// warp may move).
+    fn to_canvas(&self, h: render::Homography) -> render::Homography {
+        match &self.warp {
+            Some(w) => {
+                let [ox, oy] = w.ideal_origin();
+                render::Homography([[1.0, 0.0, -ox], [0.0, 1.0, -oy], [0.0, 0.0, 1.0]]).compose(&h)
+            }
+            None => h,
+        }
     }
 
     /// Where an ideal pixel appears in the frame (through the lens's distortion, if any).
@@ -81,7 +104,6 @@ impl Camera {
     ) -> Result<Still, CameraError> {
         let cfg = &self.config;
         let im = &cfg.imaging;
-        let (w, h) = (cfg.model.width as usize, cfg.model.height as usize);
         let h_tp = cfg.model.table_to_pixel;
         let Some(middle) = views.get(views.len() / 2) else {
             return Err(CameraError::Invalid("nothing to draw".into()));
@@ -92,7 +114,10 @@ impl Camera {
             points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]],
             shade: im.table_shade,
         };
-        let mut base = Canvas::new(w, h, h_tp, im.floor_shade)
+        // The ideal image: the frame, or larger where a lens sees past it.
+        let (cw, ch) = self.canvas_size();
+        let h_tp = self.to_canvas(h_tp);
+        let mut base = Canvas::new(cw, ch, h_tp, im.floor_shade)
             .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
         base.polygon(&table, n);
         // A still scene is drawn whole and in order. Of a moving one, the polygons and markers
@@ -112,10 +137,20 @@ impl Camera {
         let mut acc: Option<Vec<f32>> = None;
         for view in views {
             let mut canvas = base.clone();
-            for (p, _) in view.polygons.iter().zip(&fixed_polys).filter(|f| !(moving && *f.1)) {
+            for (p, _) in view
+                .polygons
+                .iter()
+                .zip(&fixed_polys)
+                .filter(|f| !(moving && *f.1))
+            {
                 canvas.polygon(p, n);
             }
-            for (m, _) in view.markers.iter().zip(&fixed_markers).filter(|f| !(moving && *f.1)) {
+            for (m, _) in view
+                .markers
+                .iter()
+                .zip(&fixed_markers)
+                .filter(|f| !(moving && *f.1))
+            {
                 self.draw_marker(&mut canvas, m)?;
             }
             match acc.as_mut() {
@@ -128,11 +163,11 @@ impl Camera {
             let k = 1.0 / views.len() as f32;
             data.iter_mut().for_each(|v| *v *= k);
         }
-        let mut canvas = Canvas::new(w, h, h_tp, 0.0)
+        let mut canvas = Canvas::new(cw, ch, h_tp, 0.0)
             .ok_or_else(|| CameraError::Invalid("singular homography".into()))?;
         canvas.data = data;
         for o in overlays {
-            canvas.set_homography(self.plane(o.height, "an occluder")?);
+            canvas.set_homography(self.to_canvas(self.plane(o.height, "an occluder")?));
             canvas.polygon(&o.polygon, n);
         }
         let truth = middle
@@ -140,9 +175,9 @@ impl Camera {
             .iter()
             .map(|m| self.truth(m))
             .collect::<Result<Vec<_>, _>>()?;
-        render::gaussian_blur(&mut canvas.data, w, h, im.blur_sigma_px);
+        render::gaussian_blur(&mut canvas.data, cw, ch, im.blur_sigma_px);
         let irradiance = match &self.warp {
-            Some(warp) => warp.apply(&canvas.data, w, h, im.floor_shade as f32),
+            Some(warp) => warp.apply(&canvas.data, cw, ch, im.floor_shade as f32),
             None => canvas.data,
         };
         Ok(Still {
@@ -187,7 +222,10 @@ impl Camera {
 
 /// Which items (by index) are the same in every view; every item counts as moving when the
 /// views do not list the same number of them.
-fn fixed<'a, T: PartialEq + 'a>(views: &[View<'a>], items: impl Fn(&View<'a>) -> &'a [T]) -> Vec<bool> {
+fn fixed<'a, T: PartialEq + 'a>(
+    views: &[View<'a>],
+    items: impl Fn(&View<'a>) -> &'a [T],
+) -> Vec<bool> {
     let first = items(&views[0]);
     if views.iter().any(|v| items(v).len() != first.len()) {
         return vec![false; first.len()];
@@ -196,4 +234,3 @@ fn fixed<'a, T: PartialEq + 'a>(views: &[View<'a>], items: impl Fn(&View<'a>) ->
         .map(|i| views.iter().all(|v| items(v)[i] == first[i]))
         .collect()
 }
-

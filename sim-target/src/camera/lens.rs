@@ -7,12 +7,19 @@
 
 use pushbot_world::lens::Intrinsics;
 
-/// Where each output pixel samples the ideal image (its index-space x, y; NaN: nowhere).
+/// Where each output pixel samples the ideal image (its index-space x, y; NaN: nowhere). The
+/// ideal image is drawn larger than the frame where the lens needs it (a barrel lens sees past
+/// the ideal frame's edges): [`LensWarp::ideal_origin`] and [`LensWarp::ideal_size`].
 #[derive(Debug, Clone)]
 pub struct LensWarp {
     lens: Intrinsics,
     map: Vec<[f32; 2]>,
+    origin: [f64; 2],
+    size: [usize; 2],
 }
+
+/// The ideal image is at most this many times the frame on each side.
+const MAX_GROWTH: f64 = 3.0;
 
 impl LensWarp {
     /// The warp of a `width`×`height` image through `lens`, which must be made for that size.
@@ -26,17 +33,49 @@ impl LensWarp {
         if let Some(p) = lens.problem() {
             return Err(format!("lens: {p}"));
         }
-        let mut map = Vec::with_capacity(width as usize * height as usize);
+        let mut ideal = Vec::with_capacity(width as usize * height as usize);
+        let (mut lo, mut hi) = ([0.0f64, 0.0], [f64::from(width), f64::from(height)]);
         for j in 0..height {
             for i in 0..width {
                 let px = [f64::from(i) + 0.5, f64::from(j) + 0.5];
-                map.push(match lens.undistort_pixel(px) {
-                    Some([u, v]) => [(u - 0.5) as f32, (v - 0.5) as f32],
-                    None => [f32::NAN; 2],
-                });
+                let q = lens.undistort_pixel(px);
+                if let Some(q) = q {
+                    for k in 0..2 {
+                        lo[k] = lo[k].min(q[k].floor() - 1.0);
+                        hi[k] = hi[k].max(q[k].ceil() + 1.0);
+                    }
+                }
+                ideal.push(q);
             }
         }
-        Ok(LensWarp { lens, map })
+        // The ideal image covers every ray the frame sees, within reason.
+        let (w, h) = (f64::from(width), f64::from(height));
+        let grow = (MAX_GROWTH - 1.0) / 2.0;
+        let lo = [lo[0].max(-grow * w), lo[1].max(-grow * h)];
+        let hi = [hi[0].min(w + grow * w), hi[1].min(h + grow * h)];
+        let map = ideal
+            .into_iter()
+            .map(|q| match q {
+                Some([u, v]) => [(u - 0.5 - lo[0]) as f32, (v - 0.5 - lo[1]) as f32],
+                None => [f32::NAN; 2],
+            })
+            .collect();
+        Ok(LensWarp {
+            lens,
+            map,
+            origin: lo,
+            size: [(hi[0] - lo[0]) as usize, (hi[1] - lo[1]) as usize],
+        })
+    }
+
+    /// Where the ideal image's top-left corner is in the ideal pixel frame (≤ 0).
+    pub fn ideal_origin(&self) -> [f64; 2] {
+        self.origin
+    }
+
+    /// The ideal image's size, pixels.
+    pub fn ideal_size(&self) -> [usize; 2] {
+        self.size
     }
 
     /// Where an ideal pixel (the homography's) appears in the distorted image.
@@ -93,12 +132,19 @@ mod tests {
     fn a_bright_spot_moves_where_the_lens_puts_it() {
         let (w, h) = (64usize, 48usize);
         let warp = LensWarp::new(lens(-0.3), 64, 48).unwrap();
+        // The ideal image reaches past the frame: a barrel lens sees more.
+        let [ox, oy] = warp.ideal_origin();
+        let [iw, ih] = warp.ideal_size();
+        assert!(
+            ox < 0.0 && oy < 0.0 && iw > w && ih > h,
+            "{ox} {oy} {iw} {ih}"
+        );
         // A 2×2 bright square in the ideal image near a corner.
-        let mut ideal = vec![0.0f32; w * h];
+        let mut ideal = vec![0.0f32; iw * ih];
         for (x, y) in [(8, 6), (9, 6), (8, 7), (9, 7)] {
-            ideal[y * w + x] = 1.0;
+            ideal[(y - oy as i64) as usize * iw + (x - ox as i64) as usize] = 1.0;
         }
-        let out = warp.apply(&ideal, w, h, 0.0);
+        let out = warp.apply(&ideal, iw, ih, 0.0);
         let (mut sx, mut sy, mut s) = (0.0, 0.0, 0.0);
         for (k, v) in out.iter().enumerate() {
             sx += f64::from(*v) * ((k % w) as f64 + 0.5);

@@ -177,7 +177,12 @@ struct Still {
 impl Still {
     /// Whether `polygons` and `markers` draw the same image as this still (every coordinate
     /// within a micrometre, a thousandth of a pixel or less).
-    fn same(&self, polygons: &[Polygon], markers: &[MarkerPlacement], overlays: &[Overlay]) -> bool {
+    fn same(
+        &self,
+        polygons: &[Polygon],
+        markers: &[MarkerPlacement],
+        overlays: &[Overlay],
+    ) -> bool {
         const EPS: f64 = 1e-6;
         let close =
             |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() <= EPS && (a[1] - b[1]).abs() <= EPS;

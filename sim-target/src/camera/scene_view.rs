@@ -157,7 +157,11 @@ impl SceneCamera {
     ) -> Result<CameraFrame, CameraError> {
         let exposure = self.scene.camera.exposure;
         let reach = self.scene.robot.bumper_radius.max(
-            self.scene.camera.robot_marker.x.hypot(self.scene.camera.robot_marker.y)
+            self.scene
+                .camera
+                .robot_marker
+                .x
+                .hypot(self.scene.camera.robot_marker.y)
                 + self.scene.camera.robot_marker.size,
         );
         let travel_m = (twist[0].abs() + twist[1].abs() * reach) * exposure;

@@ -120,7 +120,11 @@ impl CameraSpec {
     pub fn optics(&self) -> Option<crate::lens::Intrinsics> {
         self.lens.or_else(|| {
             self.pose.map(|_| {
-                crate::lens::Intrinsics::pinhole(self.width, self.height, 0.73 * f64::from(self.width))
+                crate::lens::Intrinsics::pinhole(
+                    self.width,
+                    self.height,
+                    0.73 * f64::from(self.width),
+                )
             })
         })
     }
