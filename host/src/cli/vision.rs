@@ -79,7 +79,9 @@ pub struct TrackArgs {
 #[derive(Subcommand, Debug, Clone)]
 pub enum BenchCommand {
     /// Milliseconds per 960×720 frame: the chosen vision pipeline, the reference C detector and
-    /// the kornia candidate, on the same rendered video frames, one core (thread CPU time).
+    /// the kornia candidate, on the same rendered video frames, one core (thread CPU time); then
+    /// the pipeline with the lens model on beside the C library, on the same video seen through a
+    /// lens (`--intrinsics FILE`, or a webcam's: f = 700 px, k1 = −0.08).
     Vision {
         /// Frames to render and measure.
         #[arg(long, default_value_t = 100)]
@@ -301,7 +303,16 @@ pub fn bench(_g: &Global, _cmd: BenchCommand) -> CliResult {
 pub fn bench(g: &Global, cmd: BenchCommand) -> CliResult {
     match cmd {
         BenchCommand::Vision { frames } => {
-            let r = crate::vision::bench::run(frames, g.seed)
+            let lens = g.lens()?;
+            if let Some(l) = &lens
+                && [l.width, l.height] != [960, 720]
+            {
+                return Err(CliError::bad_input(format!(
+                    "--intrinsics: the lens is for {}×{} frames, the bench renders 960×720",
+                    l.width, l.height
+                )));
+            }
+            let r = crate::vision::bench::run(frames, g.seed, lens)
                 .map_err(|e| CliError::Failed(anyhow::anyhow!(e)))?;
             if g.json {
                 println!(
@@ -343,6 +354,32 @@ pub fn bench(g: &Global, cmd: BenchCommand) -> CliResult {
                         d.corner_rms_px,
                         d.corner_bias_px[0],
                         d.corner_bias_px[1]
+                    );
+                }
+                let l = &r.lens;
+                let d = &l.intrinsics.distortion;
+                println!(
+                    "through a lens (f {:.0} px, k1 {}, k2 {}, p1 {}, p2 {}, k3 {}); calibration RMS {:.3} px",
+                    l.intrinsics.fx, d.k1, d.k2, d.p1, d.p2, d.k3, l.calibration_rms_px
+                );
+                for p in &l.pipelines {
+                    println!(
+                        "  pipeline {}, lens model on: {:.2} ms/frame mean (median {:.2}), bodies found {:.2}%, position error median {:.3} mm p99 {:.3} mm",
+                        p.name,
+                        p.time.ms_mean,
+                        p.time.ms_median,
+                        100.0 * p.bodies_found,
+                        p.position_mm[0],
+                        p.position_mm[1]
+                    );
+                }
+                for d in &l.detectors {
+                    println!(
+                        "  detector {}: {:.2} ms/frame (median {:.2}), found {:.2}%",
+                        d.name,
+                        d.time.ms_mean,
+                        d.time.ms_median,
+                        100.0 * d.detection_rate
                     );
                 }
             }

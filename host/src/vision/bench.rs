@@ -6,7 +6,9 @@
 //! `kornia-apriltag` candidate (at its defaults and with `threshold_split = 0.5`; built with
 //! `--features kornia`); with detection rate, wrong ids and corner error against the renderer's
 //! ground truth. The frames are a video ([`synth::moving_frames`]): bodies move at a pushing
-//! robot's pace, so regions of interest can follow them.
+//! robot's pace, so regions of interest can follow them. The same video is then rendered through
+//! a real lens and the chosen pipeline measures through it (the lens model on: only the detected
+//! corners are undistorted), beside the reference C detector on those frames.
 //!
 //! Time is the process's CPU time (`CLOCK_PROCESS_CPUTIME_ID`; one thread works at a time, so
 //! it is one core's work whatever else the machine runs); wall-clock time is reported beside it.
@@ -125,6 +127,33 @@ pub struct VisionBench {
     /// Every detector measured on whole frames: the reference C detector first, then the C
     /// detector at the chosen settings, then the kornia candidates (with `--features kornia`).
     pub detectors: Vec<DetectorFigures>,
+    /// The same video seen through a real lens, the pipeline measuring through it.
+    pub lens: LensFigures,
+}
+
+/// The figures through a lens: the chosen pipeline with the lens model on (corners undistorted,
+/// [`super::undistort`]) beside the reference C detector, on the same distorted frames.
+#[derive(Debug, Clone, Serialize)]
+pub struct LensFigures {
+    /// The lens the frames were rendered through.
+    pub intrinsics: pushbot_world::lens::Intrinsics,
+    /// Calibration RMS reprojection error through the lens, pixels.
+    pub calibration_rms_px: f64,
+    /// The chosen pipeline, measuring through the lens.
+    pub pipelines: Vec<PipelineFigures>,
+    /// The reference C detector on the same frames.
+    pub detectors: Vec<DetectorFigures>,
+}
+
+/// A typical webcam's lens for 960×720 frames (f = 700 px, k1 = −0.08), the bench's default.
+pub fn webcam_lens() -> pushbot_world::lens::Intrinsics {
+    pushbot_world::lens::Intrinsics {
+        distortion: pushbot_world::lens::Distortion {
+            k1: -0.08,
+            ..pushbot_world::lens::Distortion::NONE
+        },
+        ..pushbot_world::lens::Intrinsics::pinhole(960, 720, 700.0)
+    }
 }
 
 /// A detector being measured.
@@ -228,11 +257,59 @@ impl PipelineRun {
     }
 }
 
-/// Render `n` video frames and measure everything on them.
-pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
+/// Render `n` video frames and measure everything on them; then the same through `lens` (a
+/// webcam's when `None`), which must be made for 960×720 frames.
+pub fn run(
+    n: usize,
+    seed: u64,
+    lens: Option<pushbot_world::lens::Intrinsics>,
+) -> Result<VisionBench, String> {
     let layout = MarkerLayout::default_table();
     let params = SynthParams::default();
-    let frames = synth::moving_frames(&layout, n.max(1), seed, &params)?;
+    let lens = lens.unwrap_or_else(webcam_lens);
+    if [lens.width, lens.height] != params.size {
+        return Err(format!(
+            "the lens is for {}×{} frames, the bench renders {}×{}",
+            lens.width, lens.height, params.size[0], params.size[1]
+        ));
+    }
+    let (rms, pipelines, detectors) = measure_set(&layout, n, seed, params, None)?;
+    let lensed = SynthParams {
+        lens: Some(lens),
+        ..params
+    };
+    let (lens_rms, lens_pipelines, lens_detectors) =
+        measure_set(&layout, n, seed, lensed, Some(lens))?;
+    Ok(VisionBench {
+        frames: n.max(1),
+        size: params.size,
+        clock: "process CPU time (one thread at work: one core); wall_ms_mean is wall-clock".into(),
+        calibration_rms_px: rms,
+        pipelines,
+        detectors,
+        lens: LensFigures {
+            intrinsics: lens,
+            calibration_rms_px: lens_rms,
+            // Only the chosen pipeline and the reference detector: the comparison asked for.
+            pipelines: lens_pipelines.into_iter().take(1).collect(),
+            detectors: lens_detectors.into_iter().take(1).collect(),
+        },
+    })
+}
+
+/// The figures of one set of frames: calibration RMS, pipelines, detectors.
+type SetFigures = (f64, Vec<PipelineFigures>, Vec<DetectorFigures>);
+
+/// Render `n` video frames with `params` and measure every pipeline and detector on them; the
+/// calibration and the pipelines measure through `lens`.
+fn measure_set(
+    layout: &MarkerLayout,
+    n: usize,
+    seed: u64,
+    params: SynthParams,
+    lens: Option<pushbot_world::lens::Intrinsics>,
+) -> Result<SetFigures, String> {
+    let frames = synth::moving_frames(layout, n.max(1), seed, &params)?;
     let families = layout.families();
     let (c_cfg, r_cfg) = (AprilTagCConfig::default(), AprilTagCConfig::reference());
     let c_with = |cfg: &AprilTagCConfig| -> Result<Box<dyn Detector>, String> {
@@ -247,10 +324,11 @@ pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
     let first = frames
         .iter()
         .take(5)
-        .map(|f| det.detect(&f.frame).map_err(|e| e.to_string()))
+        .map(|f| det.detect_fine(&f.frame).map_err(|e| e.to_string()))
         .collect::<Result<Vec<_>, _>>()?;
-    let cal = synth::calibrate(&first, &layout, params.size)?;
-
+    let cal =
+        super::calibration::Calibration::fit_through(&first, layout, params.size, lens.as_ref())
+            .map_err(|e| e.to_string())?;
     #[cfg_attr(not(feature = "kornia"), allow(unused_mut))]
     let mut detectors = vec![
         DetectorRun::new(
@@ -306,12 +384,9 @@ pub fn run(n: usize, seed: u64) -> Result<VisionBench, String> {
             d.frame(f)?;
         }
     }
-    Ok(VisionBench {
-        frames: frames.len(),
-        size: params.size,
-        clock: "process CPU time (one thread at work: one core); wall_ms_mean is wall-clock".into(),
-        calibration_rms_px: cal.rms_px,
-        pipelines: pipelines.iter().map(|p| p.figures(frames.len())).collect(),
-        detectors: detectors.iter().map(DetectorRun::figures).collect(),
-    })
+    Ok((
+        cal.rms_px,
+        pipelines.iter().map(|p| p.figures(frames.len())).collect(),
+        detectors.iter().map(DetectorRun::figures).collect(),
+    ))
 }
