@@ -436,6 +436,50 @@ fn cli_calibrate_and_track_on_a_folder() {
     assert_eq!(out.status.code(), Some(2));
 }
 
+/// A truncated image among the frames (a camera that wrote half a file) is skipped and
+/// counted: `track` goes on with the next frame, and says how many it skipped.
+#[test]
+fn a_truncated_frame_is_skipped_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    for f in &rendered(4) {
+        f.write_png(dir.path()).unwrap();
+    }
+    let bin = env!("CARGO_BIN_EXE_pushbot");
+    let other = tempfile::tempdir().unwrap();
+    let layout = other.path().join("layout.json");
+    std::fs::write(
+        &layout,
+        serde_json::to_string(&MarkerLayout::default_table()).unwrap(),
+    )
+    .unwrap();
+    let cal = other.path().join("cal.json");
+    let (cam, layout) = (dir.path().to_str().unwrap(), layout.to_str().unwrap());
+    let out = std::process::Command::new(bin)
+        .args(["calibrate", "--camera", cam, "--layout", layout])
+        .args(["--out", cal.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // Cut the third frame's file short.
+    let third = dir.path().join("frame-000002.png");
+    let bytes = std::fs::read(&third).unwrap();
+    std::fs::write(&third, &bytes[..bytes.len() / 3]).unwrap();
+    let out = std::process::Command::new(bin)
+        .args(["track", "--camera", cam, "--layout", layout, "--json"])
+        .args(["--calibration", cal.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let seqs: Vec<u64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["seq"].as_u64().unwrap())
+        .collect();
+    assert_eq!(seqs, vec![0, 1, 3], "the bad frame is skipped, the others tracked");
+    assert!(stderr.contains("1 bad frame"), "{stderr}");
+}
+
 /// Without `--scene` or `--layout`, `pushbot calibrate` looks for the markers the README and
 /// the scene format name: calibration tags 40–45 on the bare 1.2 m × 0.9 m table.
 #[test]

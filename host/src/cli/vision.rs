@@ -10,7 +10,7 @@ use super::{CliError, CliResult, Global, Status};
 use crate::vision::calibration::Calibration;
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
-use crate::vision::source::{FrameSource, SourceError, open_source};
+use crate::vision::source::{Frame, FrameSource, SourceError, open_source};
 use crate::vision::tracking::TrackerParams;
 use crate::vision::{Pipeline, RoiParams, TrackLine};
 
@@ -106,12 +106,26 @@ fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
 fn source(args: &CameraArgs) -> Result<Box<dyn FrameSource>, CliError> {
     open_source(&args.camera, args.fps).map_err(|e| match e {
         SourceError::BadSource(m) => CliError::bad_input(m),
-        SourceError::Read(m) => CliError::Failed(anyhow::anyhow!(m)),
+        SourceError::Read(m) | SourceError::BadFrame(m) => CliError::Failed(anyhow::anyhow!(m)),
     })
 }
 
 fn read_err(e: SourceError) -> CliError {
     CliError::Failed(anyhow::anyhow!("{e}"))
+}
+
+/// The source's next usable frame: a bad one (corrupt, truncated) is skipped with a warning
+/// and counted in `skipped`.
+fn next_good(src: &mut dyn FrameSource, skipped: &mut u64) -> Result<Option<Frame>, CliError> {
+    loop {
+        match src.next_frame() {
+            Err(SourceError::BadFrame(e)) => {
+                *skipped += 1;
+                tracing::warn!("a bad frame skipped: {e}");
+            }
+            r => return r.map_err(read_err),
+        }
+    }
 }
 
 /// Collect up to `n` frames' detections and fit a calibration (the inner error: the frames do
@@ -127,8 +141,9 @@ fn calibrate_from(
         make_detector(args.detector, &lay.families()).map_err(|e| CliError::Failed(e.into()))?;
     let mut all = Vec::new();
     let mut size = [0, 0];
+    let mut skipped = 0;
     while all.len() < n.max(1) {
-        let Some(frame) = src.next_frame().map_err(read_err)? else {
+        let Some(frame) = next_good(src, &mut skipped)? else {
             break;
         };
         size = [frame.width, frame.height];
@@ -250,8 +265,9 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     let mut pipe = Pipeline::new(det, lay, cal, TrackerParams::default()).with_roi(roi);
     let mut out = std::io::stdout().lock();
     let mut count = 0;
+    let mut skipped = 0;
     while args.frames.is_none_or(|n| count < n) {
-        let Some(frame) = src.next_frame().map_err(read_err)? else {
+        let Some(frame) = next_good(src.as_mut(), &mut skipped)? else {
             break;
         };
         let r = pipe
@@ -288,6 +304,9 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     }
     if let Some(rec) = recording {
         rec.finish()?;
+    }
+    if skipped > 0 {
+        eprintln!("{skipped} bad frame(s) skipped (corrupt or truncated images)");
     }
     Ok(Status::Success)
 }

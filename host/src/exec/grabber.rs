@@ -14,6 +14,8 @@ struct Slot {
     latest: Option<(u64, Frame)>,
     /// Why the source stopped, once it has.
     ended: Option<String>,
+    /// Frames the source could not give (corrupt or truncated), skipped.
+    bad_frames: u64,
 }
 
 /// The newest frame of a camera, read on a background thread.
@@ -70,6 +72,11 @@ impl FrameGrabber {
     /// The source's description.
     pub fn describe(&self) -> &str {
         &self.describe
+    }
+
+    /// How many bad frames (corrupt or truncated) the source skipped so far.
+    pub fn bad_frames(&self) -> u64 {
+        lock(&self.shared.0).bad_frames
     }
 
     /// How many frames have been grabbed so far.
@@ -131,6 +138,10 @@ fn grab(src: &mut dyn FrameSource, shared: &Arc<(Mutex<Slot>, Condvar)>) {
                 slot.ended = Some("the source ended".into());
                 cv.notify_all();
                 return;
+            }
+            Err(SourceError::BadFrame(e)) => {
+                slot.bad_frames += 1;
+                tracing::warn!("camera: a bad frame skipped: {e}");
             }
             Err(e) => {
                 slot.ended = Some(e.to_string());

@@ -72,7 +72,7 @@ impl FrameSource for FolderSource {
         let index = self.next;
         self.next += 1;
         let img = image::open(&path)
-            .map_err(|e| SourceError::Read(format!("{}: {e}", path.display())))?;
+            .map_err(|e| SourceError::BadFrame(format!("{}: {e}", path.display())))?;
         let gray = img.into_luma8();
         let (width, height) = gray.dimensions();
         let time = std::fs::read_to_string(path.with_extension("json"))

@@ -27,6 +27,10 @@ pub enum SourceError {
     /// Reading from a working source failed.
     #[error("{0}")]
     Read(String),
+    /// One frame could not be used (a truncated or corrupt image); the source goes on with
+    /// the next. Readers skip it and count it.
+    #[error("{0}")]
+    BadFrame(String),
 }
 
 /// Something that yields frames in order.

@@ -139,7 +139,7 @@ impl FrameSource for V4l2Source {
                 Ok(to_gray(data, w, h, bpl, fmt))
             })
             .map_err(|e| SourceError::Read(format!("camera {}: {e}", self.path.display())))?
-            .map_err(SourceError::Read)?;
+            .map_err(|e| SourceError::BadFrame(format!("camera {}: {e}", self.path.display())))?;
         let time = self.start.elapsed().as_secs_f64();
         let seq = self.seq;
         self.seq += 1;
