@@ -459,7 +459,11 @@ fn a_truncated_frame_is_skipped_and_counted() {
         .args(["--out", cal.to_str().unwrap()])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // Cut the third frame's file short.
     let third = dir.path().join("frame-000002.png");
     let bytes = std::fs::read(&third).unwrap();
@@ -474,9 +478,17 @@ fn a_truncated_frame_is_skipped_and_counted() {
     let seqs: Vec<u64> = String::from_utf8(out.stdout)
         .unwrap()
         .lines()
-        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["seq"].as_u64().unwrap())
+        .map(|l| {
+            serde_json::from_str::<serde_json::Value>(l).unwrap()["seq"]
+                .as_u64()
+                .unwrap()
+        })
         .collect();
-    assert_eq!(seqs, vec![0, 1, 3], "the bad frame is skipped, the others tracked");
+    assert_eq!(
+        seqs,
+        vec![0, 1, 3],
+        "the bad frame is skipped, the others tracked"
+    );
     assert!(stderr.contains("1 bad frame"), "{stderr}");
 }
 

@@ -236,3 +236,78 @@ fn a_distorting_lens_is_undistorted_with_the_scenes_intrinsics() {
     let off = (seen.x - truth.x).hypot(seen.y - truth.y) * 1e3;
     assert!(off > 4.0, "without the lens the robot is {off:.2} mm off");
 }
+
+/// A square hand 30 cm above the table over the robot's start, shown from `from` to `until`
+/// seconds of simulated time.
+fn hand_over_start(scene: &Scene, from: f64, until: f64) -> Scene {
+    let mut s = scene.clone();
+    let p = s.robot.start;
+    let h = 0.09;
+    s.camera.occluders = vec![pushbot_world::scene::Occluder {
+        outline: vec![
+            [p.x - h, p.y - h],
+            [p.x + h, p.y - h],
+            [p.x + h, p.y + h],
+            [p.x - h, p.y + h],
+        ],
+        z: 0.3,
+        from,
+        until,
+    }];
+    s
+}
+
+/// A hand over the robot when the executor looks: it waits, frame by frame, and goes on with
+/// the robot's true pose once the hand is gone — not with a pose from before.
+#[test]
+fn an_occluded_robot_is_waited_for_then_seen_again() {
+    let scene = hand_over_start(&Scene::preset("lau-irregular").expect("preset"), 0.0, 6.0);
+    let t = target(&scene, 8);
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, options()).expect("connect");
+    let seen = robot.robot_pose();
+    assert!(
+        t.sim().truth().t >= 6.0,
+        "the pose came before the hand went (sim time {:.2} s)",
+        t.sim().truth().t
+    );
+    close(seen, t.sim().truth().pose, 3.0, 1.0);
+    robot.forward(0.05).expect("moves on");
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}
+
+/// A hand that comes and stays: the robot is lost, and the task stops with that error before
+/// the next primitive instead of acting on an old pose.
+#[test]
+fn a_robot_lost_for_good_stops_the_task() {
+    let scene = hand_over_start(
+        &Scene::preset("lau-irregular").expect("preset"),
+        20.0,
+        f64::INFINITY,
+    );
+    let t = target(&scene, 9);
+    let opts = LiveOptions {
+        reacquire_frames: 20,
+        ..options()
+    };
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, opts).expect("connect");
+    let _ = robot.robot_pose();
+    // Wait for the hand, then move a little under it and look.
+    assert!(t.sim().truth().t < 20.0, "connecting took 4 s of wall time");
+    while t.sim().truth().t < 20.2 {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    robot.forward(0.03).expect("moves under the hand");
+    let _ = robot.robot_pose();
+    let before = t.sim().truth().pose;
+    let err = robot.forward(0.05).expect_err("the robot is lost");
+    let msg = format!("{err:#}");
+    assert!(msg.contains("robot is lost"), "{msg}");
+    let now = t.sim().truth().pose;
+    assert!(
+        (now.x - before.x).hypot(now.y - before.y) < 1e-3,
+        "the robot did not move"
+    );
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}

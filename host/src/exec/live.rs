@@ -70,6 +70,9 @@ pub struct LiveOptions {
     pub lens: Option<pushbot_world::lens::Intrinsics>,
     /// Record every look, the robot's telemetry and events into this MCAP recording.
     pub recording: Option<crate::recording::RecordingHandle>,
+    /// Frames to wait for the robot or the object to be seen again when a look did not see it
+    /// (a hand over the table, a smeared marker), before the task stops with "lost".
+    pub reacquire_frames: usize,
 }
 
 impl Default for LiveOptions {
@@ -90,6 +93,7 @@ impl Default for LiveOptions {
             recover: true,
             lens: None,
             recording: None,
+            reacquire_frames: 150,
         }
     }
 }
@@ -108,6 +112,8 @@ pub struct LiveRobot {
     poses: HashMap<String, (Pose2, f64)>,
     /// Whether `poses` were looked at since the last primitive.
     fresh: bool,
+    /// Time of the first frame of the latest look: a pose older than it was not seen then.
+    look_from: f64,
     /// Why the camera stopped, once it has: the next primitive fails with it.
     camera_error: Option<String>,
     t0_us: u64,
@@ -227,6 +233,7 @@ impl LiveRobot {
             workspace,
             poses: HashMap::new(),
             fresh: false,
+            look_from: f64::NEG_INFINITY,
             camera_error: None,
             t0_us,
             idle_since: (std::time::Instant::now(), 0.0),
@@ -238,10 +245,12 @@ impl LiveRobot {
             opts,
         };
         live.look()?;
+        live.reacquire("robot");
         if !live.poses.contains_key("robot") {
             bail!(
-                "the camera does not see the robot's marker (tag {})",
-                scene.camera.robot_marker.id
+                "the camera does not see the robot's marker (tag {}) in {} frames",
+                scene.camera.robot_marker.id,
+                live.opts.reacquire_frames + 1
             );
         }
         Ok(live)
@@ -291,22 +300,11 @@ impl LiveRobot {
         let (wall, t0) = (std::time::Instant::now(), self.robot_clock());
         // The frame being rendered or exposed right now may show the past: skip it.
         let mut after = self.grabber.count() + 1;
-        for _ in 0..self.opts.frames_per_look.max(1) {
-            let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
-            after = n;
-            let r = self.pipeline.process(&frame)?;
-            self.frames_seen += 1;
-            if let Some(v) = self.view.as_mut()
-                && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
-            {
-                tracing::warn!("live view: {e:#}");
-            }
-            if let Some(rec) = &self.recording {
-                rec.look(&self.robot, &frame, &r, self.pipeline.calibration());
-            }
-            for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
-                let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
-                self.poses.insert(t.body.clone(), (p, t.time));
+        for k in 0..self.opts.frames_per_look.max(1) {
+            let time;
+            (after, time) = self.process_next(after)?;
+            if k == 0 {
+                self.look_from = time;
             }
         }
         self.fresh = true;
@@ -316,6 +314,64 @@ impl LiveRobot {
             self.robot_clock() - t0
         );
         Ok(())
+    }
+
+    /// Process the first frame after frame number `after`; its number and time.
+    fn process_next(&mut self, after: u64) -> Result<(u64, f64)> {
+        let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
+        let r = self.pipeline.process(&frame)?;
+        self.frames_seen += 1;
+        if let Some(v) = self.view.as_mut()
+            && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
+        {
+            tracing::warn!("live view: {e:#}");
+        }
+        if let Some(rec) = &self.recording {
+            rec.look(&self.robot, &frame, &r, self.pipeline.calibration());
+        }
+        for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
+            let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
+            self.poses.insert(t.body.clone(), (p, t.time));
+        }
+        Ok((n, frame.time))
+    }
+
+    /// The robot stands still between primitives: a body the latest look did not see is
+    /// waited for, frame by frame, up to `reacquire_frames`; still unseen, it is lost and the
+    /// task stops (the next primitive fails with it) rather than act on an old pose.
+    fn reacquire(&mut self, body: &str) {
+        if self.camera_error.is_some()
+            || self
+                .poses
+                .get(body)
+                .is_some_and(|(_, t)| *t >= self.look_from)
+        {
+            return;
+        }
+        let mut after = self.grabber.count();
+        for k in 0..self.opts.reacquire_frames {
+            match self.process_next(after) {
+                Ok((n, _)) => after = n,
+                Err(e) => {
+                    self.camera_error = Some(format!("{e:#}"));
+                    return;
+                }
+            }
+            if self
+                .poses
+                .get(body)
+                .is_some_and(|(_, t)| *t >= self.look_from)
+            {
+                tracing::info!("{body} seen again after {} frame(s)", k + 1);
+                return;
+            }
+        }
+        tracing::warn!("{body} lost");
+        self.camera_error = Some(format!(
+            "{body} is lost: the camera has not seen its marker in {} frames since the robot \
+             stopped (occluded, out of view, or the marker is gone)",
+            self.opts.reacquire_frames + self.opts.frames_per_look.max(1)
+        ));
     }
 
     fn look_if_stale(&mut self) {
@@ -330,6 +386,7 @@ impl LiveRobot {
 
     fn pose_of(&mut self, body: &str) -> Pose2 {
         self.look_if_stale();
+        self.reacquire(body);
         self.poses
             .get(body)
             .map_or(Pose2::new(f64::NAN, f64::NAN, f64::NAN), |(p, _)| *p)
