@@ -319,6 +319,20 @@ impl LiveRobot {
     /// Process the first frame after frame number `after`; its number and time.
     fn process_next(&mut self, after: u64) -> Result<(u64, f64)> {
         let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
+        // The robot stands still while the host looks: its odometry now is its odometry when
+        // the frame was taken, and the tracker predicts the primitive's motion from it.
+        if let Some(t) = self.robot.telemetry() {
+            let p = t.pose;
+            self.pipeline.odometry(
+                "robot",
+                frame.time,
+                crate::vision::layout::Pose::new(
+                    f64::from(p.x),
+                    f64::from(p.y),
+                    f64::from(p.theta),
+                ),
+            );
+        }
         let r = self.pipeline.process(&frame)?;
         self.frames_seen += 1;
         if let Some(v) = self.view.as_mut()
@@ -487,6 +501,8 @@ impl LiveRobot {
         self.robot
             .recover(&cause, Some((seq, command)))
             .with_context(|| format!("recovering the link after: {cause}"))?;
+        // A robot that restarted counts its odometry from zero again.
+        self.pipeline.forget_odometry("robot");
         Ok(())
     }
 

@@ -32,6 +32,7 @@ pub mod homography;
 #[cfg(feature = "kornia")]
 pub mod kornia;
 pub mod layout;
+pub mod odometry;
 pub mod simsocket;
 pub mod source;
 pub mod tracking;
@@ -234,6 +235,18 @@ impl Pipeline {
     pub fn with_roi(mut self, roi: RoiParams) -> Pipeline {
         self.roi = roi;
         self
+    }
+
+    /// The robot's odometry pose (its own frame) at `time` (the frames' clock) for `body`:
+    /// the tracker predicts that body's motion from it ([`odometry`]).
+    pub fn odometry(&mut self, body: &str, time: f64, pose: Pose) {
+        self.tracker.odometry(body, time, pose);
+    }
+
+    /// Forget `body`'s odometry (a robot that restarted counts from zero again): it is
+    /// predicted from its velocity until new odometry comes.
+    pub fn forget_odometry(&mut self, body: &str) {
+        self.tracker.forget_odometry(body);
     }
 
     /// The calibration in use.

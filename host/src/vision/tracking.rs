@@ -11,7 +11,12 @@
 //! [`TrackerParams::max_accel`] could have strayed [`TrackerParams::lost_drift`] from the
 //! prediction (two frames at 30 fps with the defaults: a robot that starts to drive fast, its marker smeared, is
 //! lost rather than left behind), or a position uncertainty (1 σ, from the covariance) past
-//! [`TrackerParams::lost_sigma`]. A lost body's pose is a guess that grows without bound; users
+//! [`TrackerParams::lost_sigma`].
+//!
+//! A body whose odometry the tracker is given ([`Tracker::odometry`]: the robot's telemetry) is
+//! predicted from it instead of from its velocity ([`super::odometry`]), as the filter's control
+//! input: its unseen motion is then known, and it is lost only by its uncertainty or after
+//! [`TrackerParams::lost_after_odometry`]. A lost body's pose is a guess that grows without bound; users
 //! of the tracker report lost instead of a pose.
 
 use std::collections::BTreeMap;
@@ -23,6 +28,7 @@ use nalgebra::{SMatrix, SVector, U3, U6};
 use serde::{Deserialize, Serialize};
 
 use super::layout::{Pose, wrap_angle};
+use super::odometry::OdometryLog;
 
 type M6 = SMatrix<f64, 6, 6>;
 type M3x6 = SMatrix<f64, 3, 6>;
@@ -59,6 +65,17 @@ pub struct TrackerParams {
     /// before it is lost.
     #[serde(default = "default_lost_drift")]
     pub lost_drift: f64,
+    /// Seconds without an accepted detection after which a body whose motion the robot's
+    /// odometry has predicted all along ([`Tracker::odometry`]) is lost.
+    #[serde(default = "default_lost_after_odometry")]
+    pub lost_after_odometry: f64,
+    /// The odometry's error, when it drives the prediction.
+    #[serde(default)]
+    pub odometry_noise: super::odometry::OdometryNoise,
+}
+
+fn default_lost_after_odometry() -> f64 {
+    3.0
 }
 
 fn default_max_accel() -> f64 {
@@ -90,6 +107,8 @@ impl Default for TrackerParams {
             lost_sigma: default_lost_sigma(),
             max_accel: default_max_accel(),
             lost_drift: default_lost_drift(),
+            lost_after_odometry: default_lost_after_odometry(),
+            odometry_noise: super::odometry::OdometryNoise::default(),
         }
     }
 }
@@ -180,6 +199,8 @@ struct Track {
     time: f64,
     last_seen: f64,
     rejected_run: u32,
+    /// Seconds predicted without odometry since the last accepted detection.
+    blind: f64,
 }
 
 /// A body's filtered pose at one frame.
@@ -208,6 +229,8 @@ pub struct Tracker {
     params: TrackerParams,
     observe: Observe,
     tracks: BTreeMap<String, Track>,
+    /// Odometry of the bodies that report it (the robot), by name.
+    odometry: BTreeMap<String, OdometryLog>,
 }
 
 impl std::fmt::Debug for Tracker {
@@ -226,7 +249,22 @@ impl Tracker {
             observe: Observe::new(&params),
             params,
             tracks: BTreeMap::new(),
+            odometry: BTreeMap::new(),
         }
+    }
+
+    /// Forget `body`'s odometry (see [`Tracker::odometry`]).
+    pub fn forget_odometry(&mut self, body: &str) {
+        self.odometry.remove(body);
+    }
+
+    /// The odometry pose of `body` (its own frame) at `time` (the frames' clock): between
+    /// frames the body's motion is then predicted from its odometry ([`super::odometry`]).
+    pub fn odometry(&mut self, body: &str, time: f64, pose: Pose) {
+        self.odometry
+            .entry(body.to_string())
+            .or_default()
+            .push(time, pose);
     }
 
     fn start(&self, z: &Pose, time: f64) -> Track {
@@ -245,6 +283,7 @@ impl Tracker {
             time,
             last_seen: time,
             rejected_run: 0,
+            blind: 0.0,
         }
     }
 
@@ -274,12 +313,31 @@ impl Tracker {
                 (None, None) => continue,
                 (Some(mut t), obs) => {
                     let dt = (time - t.time).max(0.0);
-                    let prior = Motion::new(dt, &self.params).predict(&t.est);
-                    // Keep the covariance exactly symmetric (the library checks it).
-                    let prior = StateAndCovariance::new(
-                        *prior.state(),
-                        prior.covariance().symmetric_part(),
-                    );
+                    let moved = self
+                        .odometry
+                        .get(&name)
+                        .and_then(|log| log.increment(t.time, time));
+                    let prior = match moved {
+                        Some(d) => {
+                            let (x, p) = super::odometry::predict(
+                                t.est.state(),
+                                t.est.covariance(),
+                                d,
+                                dt,
+                                &self.params.odometry_noise,
+                            );
+                            StateAndCovariance::new(x, p)
+                        }
+                        None => {
+                            t.blind += dt;
+                            let prior = Motion::new(dt, &self.params).predict(&t.est);
+                            // Keep the covariance exactly symmetric (the library checks it).
+                            StateAndCovariance::new(
+                                *prior.state(),
+                                prior.covariance().symmetric_part(),
+                            )
+                        }
+                    };
                     t.time = time;
                     t.est = prior;
                     if let Some(z) = obs {
@@ -288,6 +346,7 @@ impl Tracker {
                                 t.est = post;
                                 t.last_seen = time;
                                 t.rejected_run = 0;
+                                t.blind = 0.0;
                             }
                             None => {
                                 t.rejected_run += 1;
@@ -314,8 +373,9 @@ impl Tracker {
                 rejected,
                 age,
                 sigma_m,
-                lost: age > self.params.lost_after
-                    || 0.5 * self.params.max_accel * age * age > self.params.lost_drift
+                lost: track.blind > self.params.lost_after
+                    || age > self.params.lost_after_odometry
+                    || 0.5 * self.params.max_accel * track.blind.powi(2) > self.params.lost_drift
                     || sigma_m.is_nan()
                     || sigma_m > self.params.lost_sigma
                     || !s.iter().all(|v| v.is_finite()),
