@@ -155,7 +155,12 @@ fn marker_heights_and_the_intrinsics_file() {
     refused(&text, "objects[0].marker", "marker =", &["z (its height"]);
     let text = format!("{BASE}\n[camera]\nintrinsics = \"cam.yaml\"\n");
     let s = Scene::from_toml(&text, "t.toml").expect("intrinsics");
-    assert_eq!(s.camera.intrinsics.as_deref(), Some("cam.yaml"));
+    assert_eq!(
+        s.camera.intrinsics,
+        Some(pushbot_world::scene::IntrinsicsSpec::File(
+            "cam.yaml".into()
+        ))
+    );
     let again = Scene::from_toml(&s.to_toml(), "t.toml").unwrap();
     assert_eq!(again, s);
     let text = format!("{BASE}\n[camera]\nlens = {{ k1 = 0.1 }}\n");
@@ -435,4 +440,57 @@ fn the_lens_file_is_read_with_the_scene_and_checked() {
     std::fs::write(dir.path().join("cams/bad.yaml"), "camera_matrix: [\n").unwrap();
     let (bad, _) = scene_with("cams/bad.yaml");
     assert!(bad.is_err());
+}
+
+/// A lens written in the scene itself (OpenCV's numbers: pixel centres at integers) becomes the
+/// camera's lens for its image size; a camera's pose, exposure and occluders are checked with
+/// their paths.
+#[test]
+fn an_inline_lens_a_pose_an_exposure_and_occluders_are_read_and_checked() {
+    let with = |camera: &str| Scene::from_toml(&format!("{BASE}\n[camera]\n{camera}\n"), "s.toml");
+    let s = with("intrinsics = { fx = 700.0, fy = 702.0, cx = 479.5, cy = 359.5, k1 = -0.08 }")
+        .expect("an inline lens");
+    let lens = s.camera.lens.expect("the lens");
+    assert_eq!(
+        (lens.width, lens.height, lens.cx, lens.cy),
+        (960, 720, 480.0, 360.0)
+    );
+    assert_eq!(
+        (lens.fy, lens.distortion.k1, lens.distortion.k2),
+        (702.0, -0.08, 0.0)
+    );
+    let e = with("intrinsics = { fx = -700.0, fy = 700.0, cx = 479.5, cy = 359.5 }")
+        .expect_err("a negative focal length")
+        .to_string();
+    assert!(
+        e.contains("camera.intrinsics") && e.contains("positive"),
+        "{e}"
+    );
+    let e = with("intrinsics = { fx = 700.0, fy = 700.0, cx = 479.5, cy = 359.5, k9 = 1.0 }")
+        .expect_err("an unknown coefficient")
+        .to_string();
+    assert!(e.contains("intrinsics"), "{e}");
+
+    let s = with("pose = { eye = [0.6, -0.3, 1.0], look_at = [0.6, 0.45, 0.0] }\nexposure = 0.02")
+        .expect("a placed camera");
+    assert!(s.camera.pose.is_some() && s.camera.exposure == 0.02);
+    assert_eq!(s.camera.optics().map(|l| l.fx), Some(0.73 * 960.0));
+    let e = with("pose = { eye = [0.6, -0.3, 1.0], look_at = [0.6, 0.45, 2.0] }")
+        .expect_err("looking up")
+        .to_string();
+    assert!(e.contains("camera.pose") && e.contains("look down"), "{e}");
+    let e = with("exposure = 0.5")
+        .expect_err("longer than a frame")
+        .to_string();
+    assert!(e.contains("camera.exposure"), "{e}");
+    let e = with("occluders = [{ outline = [[0.1, 0.1], [0.3, 0.1], [0.3, 0.3]], z = -0.1 }]")
+        .expect_err("below the table")
+        .to_string();
+    assert!(e.contains("camera.occluders[0].z"), "{e}");
+    let ok = with(
+        "occluders = [{ outline = [[0.1, 0.1], [0.3, 0.1], [0.3, 0.3]], z = 0.3, from = 1.0 }]",
+    )
+    .expect("a hand from 1 s on");
+    let hand = &ok.camera.occluders[0];
+    assert!(!hand.shown_at(0.5) && hand.shown_at(1.0) && hand.shown_at(1e9));
 }

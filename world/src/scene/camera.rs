@@ -12,6 +12,8 @@
 //! # ids 40–45, 6 cm in from the four corners and the middles of the long edges
 //! fiducials = [{ id = 40, x = 0.06, y = 0.06, size = 0.05 }]
 //! intrinsics = "camera.yaml"  # lens model (ROS camera_info or OpenCV YAML), relative to the scene file
+//! # … or the lens itself, as OpenCV's camera matrix and distortion write it (pixel centres at
+//! # integers): intrinsics = { fx = 700.0, fy = 700.0, cx = 479.5, cy = 359.5, k1 = -0.08 }
 //! pose = { eye = [0.6, -0.3, 1.0], look_at = [0.6, 0.45, 0.0] }  # default: straight above
 //! exposure = 0.033             # seconds the shutter is open: moving markers smear (default 0)
 //! # things between the camera and the table (a hand), drawn over everything while shown
@@ -43,10 +45,11 @@ pub struct CameraSpec {
     /// Calibration markers fixed on the table, table frame; `None`: the default six.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fiducials: Option<Vec<Marker>>,
-    /// A file with the lens model (ROS `camera_info` YAML or OpenCV YAML), path relative to
-    /// the scene file; read into [`CameraSpec::lens`] when the scene is loaded from a file.
+    /// The lens: a file with the lens model (ROS `camera_info` YAML or OpenCV YAML, path
+    /// relative to the scene file; read into [`CameraSpec::lens`] when the scene is loaded from
+    /// a file), or its values in the scene.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub intrinsics: Option<String>,
+    pub intrinsics: Option<IntrinsicsSpec>,
     /// The lens read from `intrinsics` ([`crate::lens_file`]), checked against `width` ×
     /// `height`; `None`: an ideal pinhole.
     #[serde(skip)]
@@ -60,6 +63,68 @@ pub struct CameraSpec {
     /// Things between the camera and the table, drawn over everything while shown.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub occluders: Vec<Occluder>,
+}
+
+/// Where the scene's lens comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum IntrinsicsSpec {
+    /// A ROS `camera_info` or OpenCV `FileStorage` YAML file, relative to the scene file.
+    File(String),
+    /// The values, as OpenCV writes them.
+    Inline(InlineIntrinsics),
+}
+
+/// A lens written in the scene, in OpenCV's terms: focal lengths and principal point in pixels
+/// with pixel centres at integers (OpenCV's camera matrix), `plumb_bob` coefficients (0 when
+/// left out). The image size is the camera's.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InlineIntrinsics {
+    /// Focal length along x, px.
+    pub fx: f64,
+    /// Focal length along y, px.
+    pub fy: f64,
+    /// Principal point x, px (OpenCV: pixel centres at integers).
+    pub cx: f64,
+    /// Principal point y, px.
+    pub cy: f64,
+    /// Radial r².
+    #[serde(default)]
+    pub k1: f64,
+    /// Radial r⁴.
+    #[serde(default)]
+    pub k2: f64,
+    /// Tangential.
+    #[serde(default)]
+    pub p1: f64,
+    /// Tangential.
+    #[serde(default)]
+    pub p2: f64,
+    /// Radial r⁶.
+    #[serde(default)]
+    pub k3: f64,
+}
+
+impl InlineIntrinsics {
+    /// The lens for `width` × `height` frames (our pixel centres at `i + 0.5`).
+    pub fn for_size(&self, width: u32, height: u32) -> crate::lens::Intrinsics {
+        crate::lens::Intrinsics {
+            width,
+            height,
+            fx: self.fx,
+            fy: self.fy,
+            cx: self.cx + 0.5,
+            cy: self.cy + 0.5,
+            distortion: crate::lens::Distortion {
+                k1: self.k1,
+                k2: self.k2,
+                p1: self.p1,
+                p2: self.p2,
+                k3: self.k3,
+            },
+        }
+    }
 }
 
 /// Something between the camera and the table (a hand, an arm): a dark polygon at a height,

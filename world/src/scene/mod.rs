@@ -51,7 +51,7 @@ mod checks;
 mod error;
 mod sections;
 mod validate;
-pub use camera::{CameraSpec, Occluder};
+pub use camera::{CameraSpec, InlineIntrinsics, IntrinsicsSpec, Occluder};
 pub use error::SceneError;
 use error::{Seg, key_before, line_col, path_string, span_of};
 pub mod rearrange;
@@ -314,6 +314,9 @@ impl Scene {
             });
         }
         let notes = scene.normalise();
+        if let Some(IntrinsicsSpec::Inline(l)) = &scene.camera.intrinsics {
+            scene.camera.lens = Some(l.for_size(scene.camera.width, scene.camera.height));
+        }
         Ok((scene, notes))
     }
 
@@ -337,7 +340,7 @@ impl Scene {
             },
         })?;
         let (mut scene, notes) = Scene::from_toml_noted(&text, &file)?;
-        if let Some(name) = scene.camera.intrinsics.clone() {
+        if let Some(IntrinsicsSpec::File(name)) = scene.camera.intrinsics.clone() {
             let at = |message: String| {
                 let span = span_of(&text, &[Seg::Key("camera"), Seg::Key("intrinsics")]);
                 let (line, column) = span.map_or((None, None), |s| {

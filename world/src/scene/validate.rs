@@ -196,6 +196,11 @@ impl Scene {
                 "must be a frame rate in (0, 1000]",
             ));
         }
+        if let Some(super::IntrinsicsSpec::Inline(l)) = &c.intrinsics
+            && let Some(p) = l.for_size(c.width, c.height).problem()
+        {
+            return Err(invalid(vec![Key("camera"), Key("intrinsics")], p));
+        }
         if let Some(p) = c.pose.and_then(|p| p.problem()) {
             return Err(invalid(vec![Key("camera"), Key("pose")], p));
         }
