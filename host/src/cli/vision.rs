@@ -73,6 +73,11 @@ pub struct TrackArgs {
     /// `pushbot replay FILE` tracks them again).
     #[arg(long, value_name = "FILE.mcap")]
     pub record: Option<PathBuf>,
+    /// The robot's serial port: its telemetry's wheel odometry becomes the tracker's control
+    /// input, so a fast spin or a smeared marker is predicted from the wheels (nothing is sent
+    /// but the link's own keep-alive; drive the robot from elsewhere).
+    #[arg(long)]
+    pub port: Option<String>,
 }
 
 /// `pushbot bench …`.
@@ -263,6 +268,19 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
     };
     let mut recording = recording;
     let mut pipe = Pipeline::new(det, lay, cal, TrackerParams::default()).with_roi(roi);
+    // The robot's odometry, if its port is given: the simulated target's camera shares its clock.
+    let odometry = match &args.port {
+        Some(port) => {
+            let robot = crate::robot::Robot::connect(port, g.link_options()?)
+                .map_err(|e| CliError::bad_input(format!("--port: {e}")))?;
+            let same_clock = args.camera.camera.starts_with("sim:");
+            let feed =
+                crate::exec::odometry_feed::OdometryFeed::new(&robot, same_clock.then_some(0.0));
+            Some((robot, feed))
+        }
+        None => None,
+    };
+    let mut odometry = odometry;
     let mut out = std::io::stdout().lock();
     let mut count = 0;
     let mut skipped = 0;
@@ -270,6 +288,9 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
         let Some(frame) = next_good(src.as_mut(), &mut skipped)? else {
             break;
         };
+        if let Some((robot, feed)) = odometry.as_mut() {
+            feed.feed(robot, &mut pipe, frame.time);
+        }
         let r = pipe
             .process(&frame)
             .map_err(|e| CliError::Failed(e.into()))?;

@@ -21,6 +21,7 @@ pub mod grabber;
 pub mod io;
 pub mod live;
 pub mod maneuver;
+pub mod odometry_feed;
 pub mod primitive;
 pub mod rearrange;
 pub mod record;

@@ -17,6 +17,10 @@ type M6 = SMatrix<f64, 6, 6>;
 /// How far back samples are kept, seconds.
 const KEEP: f64 = 5.0;
 
+/// How far past its newest sample the odometry is extrapolated (at its last rate), seconds: a
+/// frame is often a report or two newer than the telemetry that has arrived.
+const EXTRAPOLATE: f64 = 0.1;
+
 /// Odometry's error: standard deviation per metre driven and per radian turned, and a floor.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct OdometryNoise {
@@ -74,10 +78,23 @@ impl OdometryLog {
         }
     }
 
-    /// The odometry pose at `time`, interpolated between the samples around it; `None` outside
-    /// the samples.
+    /// The odometry pose at `time`, interpolated between the samples around it, or up to
+    /// [`EXTRAPOLATE`] past the newest at the rate of the last two; `None` otherwise.
     pub fn at(&self, time: f64) -> Option<Pose> {
         let i = self.samples.partition_point(|&(t, _)| t < time);
+        if i == self.samples.len() {
+            let (t1, p1) = *self.samples.back()?;
+            let (t0, p0) = *self.samples.get(self.samples.len().checked_sub(2)?)?;
+            if time - t1 > EXTRAPOLATE {
+                return None;
+            }
+            let f = (time - t0) / (t1 - t0);
+            return Some(Pose::new(
+                p0.x + f * (p1.x - p0.x),
+                p0.y + f * (p1.y - p0.y),
+                p0.theta + f * (p1.theta - p0.theta),
+            ));
+        }
         let (t1, p1) = *self.samples.get(i)?;
         if t1 == time || i == 0 {
             return (t1 == time).then_some(p1);
@@ -167,6 +184,11 @@ mod tests {
         let want = wrap_angle(-3.0 - std::f64::consts::FRAC_PI_2);
         assert!((d[2] - want).abs() < 1e-12, "{d:?}");
         assert!(log.increment(-1.0, 0.5).is_none() && log.increment(0.5, 2.5).is_none());
+        // A little past the newest sample: extrapolated at the last rate.
+        let past = log.at(2.05).unwrap();
+        let turned = std::f64::consts::FRAC_PI_2 + 1.05 * want;
+        assert!((past.theta - turned).abs() < 1e-9, "{past:?}");
+        assert!(log.at(2.2).is_none(), "not far past it");
         // Out of order: ignored.
         log.push(1.5, Pose::new(9.0, 9.0, 0.0));
         assert!((log.at(1.5).unwrap().x).abs() < 1e-12);
