@@ -277,7 +277,10 @@ mod tests {
         assert!((top_left.centre[1] - (0.174 - 0.012)).abs() < 1e-12);
         let c = b.corners(MarkerFamily::Tag36h11, 147).unwrap();
         // The last tag is at the bottom right: its bottom-left corner is on y = 0.
-        assert!((c[0][1]).abs() < 1e-12 && (c[1][0] - 0.234).abs() < 1e-12, "{c:?}");
+        assert!(
+            (c[0][1]).abs() < 1e-12 && (c[1][0] - 0.234).abs() < 1e-12,
+            "{c:?}"
+        );
         assert!(c[2][1] > c[1][1] && c[3][0] < c[2][0]);
         assert_eq!(b.corners(MarkerFamily::Tag36h11, 99), None);
         assert_eq!(b.corners(MarkerFamily::Tag36h11, 148), None);
