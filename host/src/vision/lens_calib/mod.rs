@@ -388,7 +388,7 @@ mod tests {
 
     #[test]
     fn coverage_counts_cells() {
-        let centre = [[480.0, 360.0], [470.0, 350.0]];
+        let centre = [[490.0, 370.0], [500.0, 380.0]];
         assert!((coverage([&centre[..]].into_iter(), [960, 720]) - 1.0 / 48.0).abs() < 1e-12);
         let corners = [[1.0, 1.0], [959.0, 719.0], [-5.0, 3.0]];
         assert!((coverage([&corners[..]].into_iter(), [960, 720]) - 2.0 / 48.0).abs() < 1e-12);
