@@ -44,8 +44,8 @@ pub fn camera_matrix(homographies: &[Matrix3<f64>], size: [u32; 2]) -> Option<Ma
         })
         .collect();
     let k = closed_form(&hs)
-        .filter(|k| plausible(k))
-        .or_else(|| centred(&hs).filter(|k| plausible(k)))?;
+        .filter(plausible)
+        .or_else(|| centred(&hs).filter(plausible))?;
     let k = n.try_inverse()? * k;
     Some(k / k[(2, 2)])
 }
