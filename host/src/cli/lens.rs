@@ -25,7 +25,7 @@ pub struct CalibrateCommand {
     pub what: Option<CalibrateWhat>,
     /// Calibrate the table (no subcommand).
     #[command(flatten)]
-    pub table: Option<vision::CalibrateArgs>,
+    pub table: vision::CalibrateArgs,
 }
 
 /// `pushbot calibrate lens|board`.
@@ -96,13 +96,10 @@ pub struct BoardArgs {
 
 /// Run `pushbot calibrate …`.
 pub fn run(g: &Global, cmd: CalibrateCommand) -> CliResult {
-    match (cmd.what, cmd.table) {
-        (Some(CalibrateWhat::Lens(a)), _) => lens(g, a),
-        (Some(CalibrateWhat::Board(a)), _) => board(g, a),
-        (None, Some(a)) => vision::calibrate(g, a),
-        (None, None) => Err(CliError::bad_input(
-            "calibrate needs --camera (the table), or `calibrate lens` / `calibrate board`",
-        )),
+    match cmd.what {
+        Some(CalibrateWhat::Lens(a)) => lens(g, a),
+        Some(CalibrateWhat::Board(a)) => board(g, a),
+        None => vision::calibrate(g, cmd.table),
     }
 }
 

@@ -18,8 +18,9 @@ use crate::vision::{Pipeline, RoiParams, TrackLine};
 #[derive(Args, Debug, Clone)]
 pub struct CameraArgs {
     /// Frame source: /dev/videoN (V4L2), sim:HOST:PORT (the sim camera), or a folder of images.
-    #[arg(long)]
-    pub camera: String,
+    /// (Required; an `Option` only so that `calibrate lens|board` parse without it.)
+    #[arg(long, required = true)]
+    pub camera: Option<String>,
     /// The scene on the table (preset name or TOML file): its calibration markers and the
     /// markers on the robot, the objects and the goals.
     #[arg(long, value_name = "PRESET|FILE", conflicts_with = "layout")]
@@ -102,7 +103,10 @@ fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
 }
 
 fn source(args: &CameraArgs) -> Result<Box<dyn FrameSource>, CliError> {
-    open_source(&args.camera, args.fps).map_err(|e| match e {
+    let Some(camera) = &args.camera else {
+        return Err(CliError::bad_input("--camera is required"));
+    };
+    open_source(camera, args.fps).map_err(|e| match e {
         SourceError::BadSource(m) => CliError::bad_input(m),
         SourceError::Read(m) => CliError::Failed(anyhow::anyhow!(m)),
     })
