@@ -116,4 +116,41 @@ mod tests {
         };
         assert!(board_svg(&bad).is_err());
     }
+
+    /// The printed sheet, rasterised (at 96 dpi), is read by the detector: every tag with its
+    /// id where the layout puts it, corners in the layout's order.
+    #[test]
+    fn the_detector_reads_the_printed_sheet_as_the_layout_says() {
+        use crate::vision::detect::Detector;
+        let board = BoardLayout::default();
+        let png = crate::plot::render_png(&board_svg(&board).unwrap(), 1.0).unwrap();
+        let gray = image::load_from_memory(&png).unwrap().into_luma8();
+        let (width, height) = gray.dimensions();
+        let frame = crate::vision::frame::Frame {
+            seq: 0,
+            time: 0.0,
+            width,
+            height,
+            pixels: gray.into_raw(),
+        };
+        let mut det =
+            crate::vision::apriltag::AprilTagC::new(&[board.family], &Default::default()).unwrap();
+        let dets = det.detect(&frame).unwrap();
+        assert_eq!(dets.len(), 48);
+        let [bw, bh] = board.size();
+        let px_per_mm = f64::from(width) / (bw * 1e3 + 2.0 * MARGIN_MM);
+        assert!((px_per_mm - 96.0 / 25.4).abs() < 0.01, "{px_per_mm}");
+        for d in &dets {
+            let want = board.corners(d.family, d.id).expect("a board id");
+            for (c, w) in d.corners.iter().zip(want) {
+                let mm = [c[0] / px_per_mm, c[1] / px_per_mm];
+                let page = [MARGIN_MM + w[0] * 1e3, MARGIN_MM + (bh - w[1]) * 1e3];
+                assert!(
+                    (mm[0] - page[0]).hypot(mm[1] - page[1]) < 0.3,
+                    "tag {} corner at {mm:?} mm, the layout says {page:?}",
+                    d.id
+                );
+            }
+        }
+    }
 }
