@@ -249,6 +249,7 @@ fn report(
     if g.json {
         let v = serde_json::json!({"intrinsics": fit.intrinsics, "rms_px": fit.rms_px,
             "max_px": fit.max_px, "coverage": fit.coverage, "points": fit.points,
+            "outliers": fit.outliers,
             "frames": fit.frames, "views": fit.views, "refused": refusal,
             "out": if refusal.is_none() { Some(&a.out) } else { None }});
         println!("{v}");
@@ -262,10 +263,11 @@ fn report(
         .map(|(n, _)| n.as_str())
         .collect();
     println!(
-        "{} of {} frames used ({} corners); frames without the board: {}",
+        "{} of {} frames used ({} corners, {} dropped as misread); frames without the board: {}",
         fit.views.len(),
         fit.frames,
         fit.points,
+        fit.outliers,
         if skipped.is_empty() {
             "none".to_string()
         } else {

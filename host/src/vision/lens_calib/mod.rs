@@ -22,6 +22,11 @@ use super::detection::Detection;
 use super::homography::fit_homography;
 use refine::Observations;
 
+/// A corner reprojected this many times the RMS error off is an outlier ([`LensFit::outliers`]).
+pub const OUTLIER_FACTOR: f64 = 5.0;
+/// … and at least this far off, pixels.
+pub const OUTLIER_MIN_PX: f64 = 1.0;
+
 /// Tags a view needs to count.
 pub const MIN_TAGS_PER_VIEW: usize = 4;
 
@@ -214,9 +219,13 @@ impl BoardViews {
             cy: k[(1, 2)],
             distortion: pushbot_world::lens::Distortion::NONE,
         };
-        let obs: Vec<Observations> = views.iter().map(|v| v.points.clone()).collect();
-        let r = refine::refine(&start, &poses, &obs)
-            .ok_or_else(|| LensCalibError::Degenerate("the refinement did not converge".into()))?;
+        let mut obs: Vec<Observations> = views.iter().map(|v| v.points.clone()).collect();
+        let no_fit = || LensCalibError::Degenerate("the refinement did not converge".into());
+        let mut r = refine::refine(&start, &poses, &obs).ok_or_else(no_fit)?;
+        let outliers = drop_outliers(&mut obs, &r.errors);
+        if outliers > 0 {
+            r = refine::refine(&r.intrinsics, &r.poses, &obs).ok_or_else(no_fit)?;
+        }
         if let Some(p) = r.intrinsics.problem() {
             return Err(LensCalibError::Degenerate(format!("the fitted lens: {p}")));
         }
@@ -236,12 +245,39 @@ impl BoardViews {
             rms_px: rms(&all),
             max_px: all.iter().copied().fold(0.0, f64::max),
             points: all.len(),
-            coverage: coverage(views.iter().map(|v| &v.points.pixels[..]), size),
+            outliers,
+            coverage: coverage(obs.iter().map(|o| &o.pixels[..]), size),
             views: view_fits,
             frames: self.frames,
             evaluations: r.evaluations,
         })
     }
+}
+
+/// Drop the corners reprojected more than [`OUTLIER_FACTOR`] × the RMS error (and at least
+/// [`OUTLIER_MIN_PX`]) off — a misread corner of a half-hidden tag or a reflection — when they
+/// are few (at most 5 % of all) and each view keeps 16 corners; returns how many were dropped.
+fn drop_outliers(obs: &mut [Observations], errors: &[Vec<f64>]) -> usize {
+    let all: Vec<f64> = errors.iter().flatten().copied().collect();
+    let limit = (OUTLIER_FACTOR * rms(&all)).max(OUTLIER_MIN_PX);
+    let bad = all.iter().filter(|&&e| e > limit).count();
+    if bad == 0 || bad * 20 > all.len() {
+        return 0;
+    }
+    let mut dropped = 0;
+    for (o, e) in obs.iter_mut().zip(errors) {
+        let keep: Vec<bool> = e.iter().map(|&v| v <= limit).collect();
+        let kept = keep.iter().filter(|&&k| k).count();
+        if kept == e.len() || kept < 16 {
+            continue;
+        }
+        let mut k = keep.iter();
+        o.board.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        o.pixels.retain(|_| *k.next().unwrap_or(&true));
+        dropped += e.len() - kept;
+    }
+    dropped
 }
 
 fn rms(e: &[f64]) -> f64 {
@@ -289,6 +325,8 @@ pub struct LensFit {
     pub max_px: f64,
     /// Corners used.
     pub points: usize,
+    /// Corners dropped as misread (far off the first fit, and few).
+    pub outliers: usize,
     /// Fraction of the image's cells ([`COVERAGE_GRID`]) with a corner.
     pub coverage: f64,
     /// Every usable view.
@@ -383,6 +421,78 @@ mod tests {
         assert!(
             matches!(e, LensCalibError::TooFewViews { usable: 1, .. }),
             "{e}"
+        );
+    }
+
+    /// Exact corners of the board seen through a known lens from five poses, one of them
+    /// misread by 8 px: the fit drops it and finds the lens.
+    #[test]
+    fn a_misread_corner_is_dropped_and_the_lens_found() {
+        use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
+        let truth = Intrinsics {
+            width: 960,
+            height: 720,
+            fx: 700.0,
+            fy: 702.0,
+            cx: 483.0,
+            cy: 357.0,
+            distortion: pushbot_world::lens::Distortion {
+                k1: -0.08,
+                k2: 0.02,
+                p1: 0.001,
+                p2: -0.0005,
+                k3: 0.0,
+            },
+        };
+        let board = BoardLayout::default();
+        let mut views = BoardViews::new(board);
+        for (i, (rx, ry, tx, ty)) in [
+            (0.3, 0.1, -0.25, 0.2),
+            (-0.3, 0.2, 0.0, 0.2),
+            (0.2, -0.3, -0.25, 0.0),
+            (-0.2, -0.2, 0.0, 0.0),
+            (0.0, 0.4, -0.12, 0.1),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let pose = Isometry3::from_parts(
+                Translation3::new(tx, ty, 0.5),
+                UnitQuaternion::from_euler_angles(rx + std::f64::consts::PI, ry, 0.0),
+            );
+            let dets: Vec<Detection> = board
+                .placements()
+                .iter()
+                .map(|p| {
+                    det(
+                        p.id,
+                        p.corners().map(|b| {
+                            let c = pose * Point3::new(b[0], b[1], 0.0);
+                            truth.project([c.x, c.y, c.z]).unwrap()
+                        }),
+                    )
+                })
+                .map(|mut d| {
+                    if i == 2 && d.id == 120 {
+                        d.corners[1][0] += 8.0;
+                    }
+                    d
+                })
+                .collect();
+            views.add(&format!("v{i}"), [960, 720], &dets).unwrap();
+        }
+        let fit = views.fit(4).unwrap();
+        assert_eq!(fit.outliers, 1);
+        assert_eq!(fit.points, 5 * 48 * 4 - 1);
+        assert!(fit.rms_px < 1e-4, "{}", fit.rms_px);
+        let l = fit.intrinsics;
+        assert!(
+            (l.fx - truth.fx).abs() < 1e-3 && (l.cy - truth.cy).abs() < 1e-3,
+            "{l:?}"
+        );
+        assert!(
+            (l.distortion.k1 - truth.distortion.k1).abs() < 1e-5,
+            "{l:?}"
         );
     }
 
