@@ -262,6 +262,7 @@ fn calibrate_lens_writes_an_intrinsics_file_that_reads_back() {
     assert_eq!(BoardLayout::load(&layout).unwrap(), BoardLayout::default());
     for (format, file) in [("ros", "lens.yaml"), ("opencv", "lens-cv.yaml")] {
         let yaml = tmp.path().join(file);
+        let t0 = std::time::Instant::now();
         let (code, out, err) = pushbot(&[
             "calibrate",
             "lens",
@@ -274,7 +275,11 @@ fn calibrate_lens_writes_an_intrinsics_file_that_reads_back() {
             "--format",
             format,
         ]);
-        eprintln!("{out}{err}");
+        eprintln!(
+            "{out}{err}calibrate lens on {} frames: {:.2} s",
+            good_views().len(),
+            t0.elapsed().as_secs_f64()
+        );
         assert_eq!(code, 0, "{out}{err}");
         assert!(out.contains("reprojection RMS"), "{out}");
         let l = pushbot_world::lens_file::read_intrinsics(&yaml).unwrap();
