@@ -69,13 +69,13 @@ pub struct LensArgs {
     #[arg(long, default_value = "pushbot_camera")]
     pub name: String,
     /// Refuse a fit whose RMS reprojection error is above this, pixels.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = Requirements::default().max_rms_px)]
     pub max_rms: f64,
     /// Refuse a fit whose corners cover less than this fraction of the image (8 × 6 cells).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = Requirements::default().min_coverage)]
     pub min_coverage: f64,
     /// Fewest usable views (frames showing at least 4 of the board's tags).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = Requirements::default().min_views)]
     pub min_views: usize,
     /// Marker detector.
     #[arg(long, value_enum, default_value = "apriltag-c")]
