@@ -257,13 +257,14 @@ fn report(
     }
     let l = &fit.intrinsics;
     let d = l.distortion;
-    let skipped: Vec<&str> = seen
+    // Frames without the board (their tag count), or left out of many.
+    let skipped: Vec<String> = seen
         .iter()
         .filter(|(n, _)| !fit.views.iter().any(|v| &v.name == n))
-        .map(|(n, _)| n.as_str())
+        .map(|(n, tags)| format!("{n} ({tags} tags)"))
         .collect();
     println!(
-        "{} of {} frames used ({} corners, {} dropped as misread); frames without the board: {}",
+        "{} of {} frames used ({} corners, {} dropped as misread); not used: {}",
         fit.views.len(),
         fit.frames,
         fit.points,

@@ -27,6 +27,10 @@ pub const OUTLIER_FACTOR: f64 = 5.0;
 /// … and at least this far off, pixels.
 pub const OUTLIER_MIN_PX: f64 = 1.0;
 
+/// The most views fitted at once (the solver's Jacobian is dense: 40 views of 48 tags are
+/// 15 360 residuals × 249 parameters); of more, an even spread in frame order is used.
+pub const MAX_VIEWS: usize = 40;
+
 /// Tags a view needs to count.
 pub const MIN_TAGS_PER_VIEW: usize = 4;
 
@@ -190,10 +194,11 @@ impl BoardViews {
         let Some(size) = self.size else {
             return Err(too_few(0));
         };
-        // Views whose homography cannot be fitted are dropped.
+        // Views whose homography cannot be fitted are dropped; of many, an even spread is kept.
         let mut views = Vec::new();
         let mut hs = Vec::new();
-        for v in &self.views {
+        for i in spread(self.views.len(), MAX_VIEWS) {
+            let v = &self.views[i];
             if let Ok(h) = fit_homography(&v.points.board, &v.points.pixels) {
                 hs.push(Matrix3::from_fn(|r, c| h.0[r][c]));
                 views.push(v);
@@ -278,6 +283,14 @@ fn drop_outliers(obs: &mut [Observations], errors: &[Vec<f64>]) -> usize {
         dropped += e.len() - kept;
     }
     dropped
+}
+
+/// At most `max` of the indices `0..n`, evenly spread from the first to the last.
+fn spread(n: usize, max: usize) -> Vec<usize> {
+    if n <= max || max < 2 {
+        return (0..n.min(max)).collect();
+    }
+    (0..max).map(|k| k * (n - 1) / (max - 1)).collect()
 }
 
 fn rms(e: &[f64]) -> f64 {
@@ -494,6 +507,14 @@ mod tests {
             (l.distortion.k1 - truth.distortion.k1).abs() < 1e-5,
             "{l:?}"
         );
+    }
+
+    #[test]
+    fn many_views_are_thinned_evenly() {
+        assert_eq!(spread(5, 40), vec![0, 1, 2, 3, 4]);
+        let s = spread(100, 40);
+        assert_eq!((s.len(), s[0], s[39]), (40, 0, 99));
+        assert!(s.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 3));
     }
 
     #[test]
