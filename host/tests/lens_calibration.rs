@@ -282,6 +282,7 @@ fn calibrate_lens_writes_an_intrinsics_file_that_reads_back() {
         );
         assert_eq!(code, 0, "{out}{err}");
         assert!(out.contains("reprojection RMS"), "{out}");
+        assert!(out.contains("not used: none"), "{out}");
         let l = pushbot_world::lens_file::read_intrinsics(&yaml).unwrap();
         let truth = webcam();
         assert_eq!((l.width, l.height), (960, 720));
@@ -315,6 +316,23 @@ fn calibrate_lens_refuses_poor_frame_sets_with_exit_1() {
     assert_eq!(code, 1, "{out}{err}");
     assert!(err.contains("cover") && err.contains("edges"), "{err}");
     assert!(!yaml.exists(), "a refused fit writes no file");
+    // With --json: one error object on stdout.
+    let (code, out, _) = pushbot(&[
+        "calibrate",
+        "lens",
+        "--frames",
+        centre.to_str().unwrap(),
+        "--out",
+        yaml.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(out.trim()).expect("one JSON object");
+    assert_eq!(v["error"]["exit_code"], 1, "{v}");
+    assert!(
+        v["error"]["message"].as_str().unwrap().contains("cover"),
+        "{v}"
+    );
     // Frames without the board.
     let blank = tmp.path().join("blank");
     std::fs::create_dir(&blank).unwrap();

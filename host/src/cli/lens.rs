@@ -247,12 +247,14 @@ fn report(
     refusal: Option<&str>,
 ) -> Result<(), CliError> {
     if g.json {
-        let v = serde_json::json!({"intrinsics": fit.intrinsics, "rms_px": fit.rms_px,
-            "max_px": fit.max_px, "coverage": fit.coverage, "points": fit.points,
-            "outliers": fit.outliers,
-            "frames": fit.frames, "views": fit.views, "refused": refusal,
-            "out": if refusal.is_none() { Some(&a.out) } else { None }});
-        println!("{v}");
+        // A refused fit prints only the error object (its message says why).
+        if refusal.is_none() {
+            let v = serde_json::json!({"intrinsics": fit.intrinsics, "rms_px": fit.rms_px,
+                "max_px": fit.max_px, "coverage": fit.coverage, "points": fit.points,
+                "outliers": fit.outliers, "frames": fit.frames, "views": fit.views,
+                "out": a.out});
+            println!("{v}");
+        }
         return Ok(());
     }
     let l = &fit.intrinsics;
