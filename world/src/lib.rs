@@ -3,6 +3,7 @@
 //! * [`Pose`] — the one planar pose (SE(2), on `nalgebra`);
 //! * [`geometry`] — outlines as convex parts and their overlaps, on `parry2d`;
 //! * [`polygon`] — simple-polygon checks in O(n log n) and winding normalisation;
+//! * [`board`] — the lens-calibration board: an AprilTag grid and its layout file;
 //! * [`body`] — the robot's build (round bumper, front plate, switches);
 //! * [`scene`] — the one scene format (TOML), its validation with file:line:col errors, and
 //!   [`presets`];
@@ -18,6 +19,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod board;
 pub mod body;
 pub mod camera;
 pub mod camera_pose;

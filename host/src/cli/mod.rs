@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub mod demo;
+pub mod lens;
 pub mod link_bench;
 pub mod rearrange;
 pub mod replay;
@@ -103,8 +104,10 @@ pub enum Command {
     Collect(strategy_args::CollectArgs),
     /// Evaluate: `eval delivery` (Lau et al. Fig. 11, learned vs dipole).
     Eval(strategy_args::EvalArgs),
-    /// Calibrate the overhead camera from markers at known table positions.
-    Calibrate(vision::CalibrateArgs),
+    /// Calibrate the overhead camera from markers at known table positions; `calibrate lens`
+    /// finds the lens's intrinsics and distortion from frames of a printed board
+    /// (`calibrate board` writes it).
+    Calibrate(lens::CalibrateCommand),
     /// Track the robot, objects and goals with the overhead camera (one line per frame).
     Track(vision::TrackArgs),
     /// Re-run tracking from a recording (`--record`, the demo's run.mcap) and write its report.
@@ -234,6 +237,11 @@ pub const EXAMPLES: &[(&str, &str)] = &[
         "calibrate",
         "pushbot calibrate --camera /dev/video0 --scene lau-irregular --out calibration.json",
     ),
+    (
+        "calibrate lens",
+        "pushbot calibrate lens --frames board-frames/ --layout board.toml --out lens.yaml",
+    ),
+    ("calibrate board", "pushbot calibrate board --out board.svg"),
     (
         "track",
         "pushbot track --camera sim:127.0.0.1:5600 --scene lau-irregular --frames 100 --json",
@@ -370,7 +378,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
         Command::Bench(BenchCommand::Stable(a)) => stable::run_bench(&global, &a),
         Command::Bench(BenchCommand::Link(a)) => link_bench::run(&global, &a),
-        Command::Calibrate(a) => vision::calibrate(&global, a),
+        Command::Calibrate(a) => lens::run(&global, a),
         Command::Track(a) => vision::track(&global, a),
         Command::Replay(a) => replay::run(&global, a),
         Command::Bench(BenchCommand::Vision(b)) => vision::bench(&global, b),

@@ -18,8 +18,9 @@ use crate::vision::{Pipeline, RoiParams, TrackLine};
 #[derive(Args, Debug, Clone)]
 pub struct CameraArgs {
     /// Frame source: /dev/videoN (V4L2), sim:HOST:PORT (the sim camera), or a folder of images.
-    #[arg(long)]
-    pub camera: String,
+    /// (Required; an `Option` only so that `calibrate lens|board` parse without it.)
+    #[arg(long, required = true)]
+    pub camera: Option<String>,
     /// The scene on the table (preset name or TOML file): its calibration markers and the
     /// markers on the robot, the objects and the goals.
     #[arg(long, value_name = "PRESET|FILE", conflicts_with = "layout")]
@@ -109,7 +110,10 @@ fn layout(args: &CameraArgs) -> Result<MarkerLayout, CliError> {
 }
 
 fn source(args: &CameraArgs) -> Result<Box<dyn FrameSource>, CliError> {
-    open_source(&args.camera, args.fps).map_err(|e| match e {
+    let Some(camera) = &args.camera else {
+        return Err(CliError::bad_input("--camera is required"));
+    };
+    open_source(camera, args.fps).map_err(|e| match e {
         SourceError::BadSource(m) => CliError::bad_input(m),
         SourceError::Read(m) | SourceError::BadFrame(m) => CliError::Failed(anyhow::anyhow!(m)),
     })
@@ -273,7 +277,11 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
         Some(port) => {
             let robot = crate::robot::Robot::connect(port, g.link_options()?)
                 .map_err(|e| CliError::bad_input(format!("--port: {e}")))?;
-            let same_clock = args.camera.camera.starts_with("sim:");
+            let same_clock = args
+                .camera
+                .camera
+                .as_deref()
+                .is_some_and(|c| c.starts_with("sim:"));
             let feed =
                 crate::exec::odometry_feed::OdometryFeed::new(&robot, same_clock.then_some(0.0));
             Some((robot, feed))

@@ -51,6 +51,13 @@ impl FolderSource {
     }
 }
 
+impl FolderSource {
+    /// The image files, in the order their frames come (frame `seq` is file `seq`).
+    pub fn files(&self) -> &[PathBuf] {
+        &self.files
+    }
+}
+
 #[derive(serde::Deserialize)]
 struct Sidecar {
     time: f64,

@@ -9,6 +9,9 @@
 //!   `kornia-apriltag` (`kornia`); [`detect::make_detector`] picks one;
 //! - [`homography`] and [`calibration`]: pixel → table-plane homography from markers at known
 //!   places;
+//! - [`lens_calib`]: the lens's intrinsics and distortion from frames of a printed AprilTag
+//!   board (Zhang's method, Levenberg–Marquardt), and `board_svg` (with `sim`): the board to
+//!   print;
 //! - [`layout`]: which marker is where (until the shared scene format carries it);
 //! - [`tracking`]: a Kalman filter per body;
 //! - [`Pipeline`]: detect → measure → filter per frame; between whole-frame searches it looks
@@ -23,6 +26,8 @@
 pub mod apriltag;
 #[cfg(feature = "sim")]
 pub mod bench;
+#[cfg(feature = "sim")]
+pub mod board_svg;
 pub mod calibration;
 pub mod detect;
 pub mod detection;
@@ -32,6 +37,7 @@ pub mod homography;
 #[cfg(feature = "kornia")]
 pub mod kornia;
 pub mod layout;
+pub mod lens_calib;
 pub mod odometry;
 pub mod simsocket;
 pub mod source;

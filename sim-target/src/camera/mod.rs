@@ -7,6 +7,7 @@
 //! the table and its exact corners in pixels (pixel centres at `i + 0.5`). Frames can be written
 //! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
 
+pub mod board;
 pub mod draw;
 pub mod families;
 pub mod lens;
