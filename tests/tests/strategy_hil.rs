@@ -55,3 +55,99 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     assert!(d < 0.03, "object ended {d:.3} m from the goal");
     t.shutdown().expect("sim ran cleanly");
 }
+
+/// The camera as it is (issue 20): a webcam lens (k1 = −0.08, given as the scene's intrinsics
+/// file), the robot's marker 6 cm and the object's 3 cm above the table. A strategy collected in
+/// process delivers the object through the serial port and this camera from Lau et al.'s start C.
+#[test]
+fn a_delivery_through_a_distorting_lens_with_raised_markers_reaches_the_goal() {
+    pushbot_tests::init_logging();
+    let _limit = pushbot_tests::WallLimit::arm(
+        "a_delivery_through_a_distorting_lens_with_raised_markers_reaches_the_goal",
+        std::time::Duration::from_secs(10 * 60),
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let strategy = dir.path().join("irregular.strategy.json");
+    let argv = [
+        "pushbot",
+        "--json",
+        "collect",
+        "--scene",
+        "lau-irregular",
+        "--object",
+        "object",
+        "--initial",
+        "150",
+        "--streak",
+        "0",
+        "--out",
+        strategy.to_str().expect("utf-8 path"),
+    ];
+    let st = run(Cli::try_parse_from(argv).expect("arguments parse")).expect("collects");
+    assert_eq!(st, Status::Success);
+
+    // The lens as a ROS camera_info file beside the scene, the heights in the scene.
+    std::fs::write(
+        dir.path().join("webcam.yaml"),
+        "image_width: 960\nimage_height: 720\ncamera_name: webcam\ncamera_matrix:\n  rows: 3\n  \
+         cols: 3\n  data: [700.0, 0.0, 479.5, 0.0, 700.0, 359.5, 0.0, 0.0, 1.0]\n\
+         distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  \
+         data: [-0.08, 0.0, 0.0, 0.0, 0.0]\n",
+    )
+    .expect("write the lens");
+    let text = pushbot_world::presets::text("lau-irregular")
+        .expect("preset")
+        .replace(
+            "pose = { x = 0.45, y = 0.95, theta = 0.0 }\nmass",
+            "pose = { x = 0.45, y = 0.25, theta = 3.1416 }\nmass",
+        )
+        .replace(
+            "marker = { id = 1, x = 0, y = 0, size = 0.05 }",
+            "marker = { id = 1, x = 0, y = 0, size = 0.05, z = 0.03 }",
+        )
+        + "\n[camera]\nintrinsics = \"webcam.yaml\"\n\
+           robot_marker = { id = 0, x = 0.0, y = 0.0, size = 0.05, z = 0.06 }\n";
+    let path = dir.path().join("irregular-real.toml");
+    std::fs::write(&path, text).expect("write the scene");
+    let scene = Scene::load(&path).expect("the scene loads");
+    assert!(scene.camera.lens.is_some(), "the lens is read with the scene");
+    assert_eq!(
+        scene.objects[0].marker.map(|m| m.z),
+        Some(0.03),
+        "the object's marker is raised"
+    );
+    assert!((scene.objects[0].pose.y - 0.25).abs() < 1e-9, "start C");
+    let goal = scene.goals[0].pose;
+    let t =
+        SimTarget::start(&scene, 22, SIM_SPEED, None, None).expect("start the simulated target");
+    let watchdog = ((1000.0 * SIM_SPEED) as u16).to_string();
+    let argv = [
+        "pushbot",
+        "--json",
+        "eval",
+        "delivery",
+        "--hil",
+        "--port",
+        t.port(),
+        "--camera",
+        t.camera(),
+        "--scene",
+        path.to_str().expect("utf-8 path"),
+        "--method",
+        "learned",
+        "--strategy",
+        strategy.to_str().expect("utf-8 path"),
+        "--trials",
+        "1",
+        "--time-limit",
+        "480",
+        "--watchdog-ms",
+        &watchdog,
+    ];
+    let st = run(Cli::try_parse_from(argv).expect("arguments parse")).expect("runs");
+    let o = t.sim().objects()[0].1;
+    let d = (o.x - goal.x).hypot(o.y - goal.y);
+    assert_eq!(st, Status::Success, "object ended {d:.3} m from the goal");
+    assert!(d < 0.03, "object ended {d:.3} m from the goal");
+    t.shutdown().expect("sim ran cleanly");
+}
