@@ -110,7 +110,10 @@ fn a_delivery_through_a_distorting_lens_with_raised_markers_reaches_the_goal() {
     let path = dir.path().join("irregular-real.toml");
     std::fs::write(&path, text).expect("write the scene");
     let scene = Scene::load(&path).expect("the scene loads");
-    assert!(scene.camera.lens.is_some(), "the lens is read with the scene");
+    assert!(
+        scene.camera.lens.is_some(),
+        "the lens is read with the scene"
+    );
     assert_eq!(
         scene.objects[0].marker.map(|m| m.z),
         Some(0.03),

@@ -38,9 +38,10 @@ pub struct Calibration {
     /// measures through the same lens. `None`: an ideal pinhole (raw corners).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lens: Option<pushbot_world::lens::Intrinsics>,
-    /// The camera's centre in the table frame (metres, z up), known when the lens is: from the
-    /// homography and the intrinsics (`H = K [r1 r2 t]`, Zhang's extrinsics for one view). A
-    /// marker at a height is then placed where its ray meets its own plane.
+    /// The camera's centre in the table frame (metres, z up), known when the lens is: the
+    /// camera's pose solved from the calibration markers through the lens ([`super::pnp`],
+    /// started from the homography's decomposition `H = K [r1 r2 t]`). A marker at a height is
+    /// then placed where its ray meets its own plane.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera_centre: Option<[f64; 3]>,
 }
@@ -75,22 +76,7 @@ impl Calibration {
         layout: &MarkerLayout,
         image_size: [u32; 2],
     ) -> Result<Calibration, CalibrationError> {
-        let mut table = Vec::new();
-        let mut pixel = Vec::new();
-        let mut ids = BTreeSet::new();
-        for dets in frames {
-            for d in dets {
-                let Some(m) = layout.fixed_marker(d.family, d.id) else {
-                    continue;
-                };
-                let p = m.placement();
-                table.extend(p.corners());
-                table.push(p.centre);
-                pixel.extend(d.corners);
-                pixel.push(d.centre);
-                ids.insert(d.id);
-            }
-        }
+        let (table, pixel, ids) = point_pairs(frames, layout);
         if ids.len() < 4 {
             return Err(CalibrationError::TooFewMarkers {
                 seen: ids.into_iter().collect(),
@@ -158,6 +144,23 @@ impl Calibration {
         let mut cal = Calibration::fit(&ideal, layout, image_size)?;
         cal.lens = Some(*lens);
         cal.camera_centre = camera_centre(&cal.table_to_pixel, lens);
+        // The camera's pose by PnP through the whole lens, from the homography's: its
+        // reprojection error is the model's own, in the frame's pixels.
+        let (table, raw, _) = point_pairs(frames, layout);
+        if let Some(start) = CameraPose::from_homography(&cal.table_to_pixel, lens)
+            && let Some((pose, errs)) = super::pnp::solve(lens, &start, &table, &raw)
+            && let Some(h) = pose.plane_homography(lens, 0.0)
+            && let Some(inv) = h.inverse()
+        {
+            let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+            if rms.is_finite() {
+                cal.table_to_pixel = h;
+                cal.pixel_to_table = inv;
+                cal.rms_px = rms;
+                cal.max_px = errs.iter().copied().fold(0.0, f64::max);
+                cal.camera_centre = Some(pose.centre());
+            }
+        }
         Ok(cal)
     }
 
@@ -234,6 +237,31 @@ impl Calibration {
         (cx.is_finite() && cy.is_finite() && theta.is_finite())
             .then_some((Pose::new(cx, cy, theta), side))
     }
+}
+
+/// Every sighting of a calibration marker in `frames` as point pairs — its four corners and its
+/// centre on the table (metres) and in the frame (pixels) — and the ids seen.
+fn point_pairs(
+    frames: &[Vec<Detection>],
+    layout: &MarkerLayout,
+) -> (Vec<[f64; 2]>, Vec<[f64; 2]>, BTreeSet<u32>) {
+    let mut table = Vec::new();
+    let mut pixel = Vec::new();
+    let mut ids = BTreeSet::new();
+    for dets in frames {
+        for d in dets {
+            let Some(m) = layout.fixed_marker(d.family, d.id) else {
+                continue;
+            };
+            let p = m.placement();
+            table.extend(p.corners());
+            table.push(p.centre);
+            pixel.extend(d.corners);
+            pixel.push(d.centre);
+            ids.insert(d.id);
+        }
+    }
+    (table, pixel, ids)
 }
 
 /// The camera's centre in the table frame from the table → ideal-pixel homography and the

@@ -39,6 +39,7 @@ pub mod kornia;
 pub mod layout;
 pub mod lens_calib;
 pub mod odometry;
+pub mod pnp;
 pub mod simsocket;
 pub mod source;
 pub mod tracking;

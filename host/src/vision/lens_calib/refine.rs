@@ -64,7 +64,7 @@ fn lens_of(size: [u32; 2], p: &[f64]) -> Intrinsics {
     }
 }
 
-fn pose_of(p: &[f64]) -> Isometry3<f64> {
+pub(crate) fn pose_of(p: &[f64]) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(p[3], p[4], p[5]),
         UnitQuaternion::from_scaled_axis(Vector3::new(p[0], p[1], p[2])),
@@ -72,7 +72,7 @@ fn pose_of(p: &[f64]) -> Isometry3<f64> {
 }
 
 /// The reprojection residuals (x, y per point) of one view under lens `l` and pose `pose`.
-fn view_residuals(l: &Intrinsics, pose: &[f64], v: &Observations, out: &mut [f64]) {
+pub(crate) fn view_residuals(l: &Intrinsics, pose: &[f64], v: &Observations, out: &mut [f64]) {
     let iso = pose_of(pose);
     for (k, (b, px)) in v.board.iter().zip(&v.pixels).enumerate() {
         let c = iso * Point3::new(b[0], b[1], 0.0);
