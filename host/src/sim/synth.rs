@@ -2,6 +2,9 @@
 //! calibration markers and bodies at random poses with random mild blur, noise and exposure.
 //! Used by the vision tests and `pushbot bench vision`.
 
+/// The AprilTag families' bit patterns the renderer draws (the calibration board's SVG prints
+/// the same).
+pub use pushbot_sim::camera::TagCodes;
 use pushbot_sim::camera::{Camera, CameraConfig, CameraModel, Imaging, MarkerTruth, Polygon};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -1,9 +1,9 @@
 //! The printable calibration board: an SVG at true size (millimetres) of a
 //! [`BoardLayout`], each tag's bit pattern from the simulated camera's family tables
-//! ([`pushbot_sim::camera::TagCodes`], the AprilTag library's data), with the layout described
+//! ([`crate::sim::synth::TagCodes`], the AprilTag library's data, from the simulator's renderer), with the layout described
 //! on the sheet and a 100 mm scale bar to check the print's scale.
 
-use pushbot_sim::camera::TagCodes;
+use crate::sim::synth::TagCodes;
 use pushbot_world::board::BoardLayout;
 use svg::Node;
 use svg::node::element::Element;
