@@ -103,7 +103,9 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
     );
     let model = Model::new(&problem)
         .map_err(|e| CliError::bad_input(format!("scene `{}`: {e}", args.scene)))?;
+    let pb = spinner(global, "cost map");
     let map = rearrange::cost_map(&model).map_err(|e| CliError::Failed(e.into()))?;
+    pb.finish_and_clear();
     let start = model.pack(&problem.start).ok_or_else(|| {
         CliError::bad_input(format!("scene `{}`: the start is not free", args.scene))
     })?;
@@ -224,7 +226,9 @@ fn plan_practical(global: &Global, args: &PlanArgs, problem: &Problem) -> CliRes
             human(ExactBudget::of(problem).bytes)
         );
     }
+    let pb = spinner(global, "object-level search");
     let result = practical::plan_practical(problem, &Options::for_problem(problem));
+    pb.finish_and_clear();
     let peak = peak_kib();
     match result {
         Ok(p) => {
@@ -323,9 +327,20 @@ fn plan_practical(global: &Global, args: &PlanArgs, problem: &Problem) -> CliRes
     }
 }
 
+/// A spinner on stderr while long work runs (hidden with `--json` and off a terminal).
+fn spinner(global: &Global, what: &str) -> indicatif::ProgressBar {
+    if global.json {
+        return indicatif::ProgressBar::hidden();
+    }
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message(what.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
 /// The exact map's configurations as text.
 fn budget_text(problem: &Problem) -> String {
-    format!("{:.2e}", ExactBudget::of(problem).configurations as f64)
+    format!("{:.2e}", ExactBudget::of(problem).configurations_f64)
 }
 
 /// Run `pushbot bench rearrange`.
@@ -364,7 +379,7 @@ fn print_row(r: &rearrange_bench::Row) {
         "{}: {} movables, {:.3e} configurations (exact map ≈ {})",
         r.name,
         r.movables,
-        r.configurations as f64,
+        r.configurations,
         human(r.map_bytes_estimate)
     );
     match &r.exact_refused {

@@ -151,7 +151,7 @@ pub struct Row {
     /// Movables.
     pub movables: usize,
     /// Configurations of the exact map.
-    pub configurations: u64,
+    pub configurations: f64,
     /// Estimated bytes of the exact map.
     pub map_bytes_estimate: u64,
     /// Why the exact planner refused, if it did.
@@ -192,7 +192,7 @@ pub fn run(inst: &Instance, practical: bool) -> Row {
     let mut row = Row {
         name: p.name.clone(),
         movables: p.movables.len(),
-        configurations: budget.configurations,
+        configurations: budget.configurations_f64,
         map_bytes_estimate: budget.bytes,
         exact_refused: budget.check().err().map(|e| e.to_string()),
         states_mapped: None,

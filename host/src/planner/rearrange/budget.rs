@@ -8,10 +8,12 @@ use super::costmap::map_bytes_estimate;
 use super::problem::{MAX_MOVABLES, Model, Problem};
 
 /// What the exact cost map of a problem would take.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ExactBudget {
     /// Packed configurations (saturates at `u64::MAX`).
     pub configurations: u64,
+    /// The same as a float (does not saturate).
+    pub configurations_f64: f64,
     /// Bytes the map and its wave front need at their peak (estimate; saturates).
     pub bytes: u64,
     /// Bytes the system has available (`MemAvailable`), if it tells.
@@ -59,9 +61,11 @@ impl ExactBudget {
     /// Size the exact map of `p` (`max_edge` from its model when it has one, else a bound).
     pub fn of(p: &Problem) -> ExactBudget {
         let configurations = Model::configurations(p);
+        let configurations_f64 = Model::configurations_f64(p);
         let max_edge = Model::new(p).map(|m| m.max_edge).unwrap_or(u32::MAX - 1);
         ExactBudget {
             configurations,
+            configurations_f64,
             bytes: map_bytes_estimate(configurations, max_edge),
             available: available_bytes(),
             movables: p.movables.len(),
@@ -96,7 +100,9 @@ impl ExactBudget {
 
 /// Bytes as MiB or GiB.
 pub fn human(bytes: u64) -> String {
-    if bytes >= 1 << 30 {
+    if bytes >= 1 << 40 {
+        format!("{:.2e} GiB", bytes as f64 / (1u64 << 30) as f64)
+    } else if bytes >= 1 << 30 {
         format!("{:.1} GiB", bytes as f64 / (1u64 << 30) as f64)
     } else {
         format!("{:.0} MiB", (bytes as f64 / (1u64 << 20) as f64).ceil())
@@ -115,6 +121,18 @@ impl Model {
     /// Packed configurations of a problem's exact map, from its bodies' free placements
     /// (saturating; no tables are built).
     pub fn configurations(p: &Problem) -> u64 {
+        Model::placements(p)
+            .into_iter()
+            .fold(1u64, |n, k| n.saturating_mul(k))
+    }
+
+    /// The same as a float, for sizes past `u64`.
+    pub fn configurations_f64(p: &Problem) -> f64 {
+        Model::placements(p).into_iter().map(|k| k as f64).product()
+    }
+
+    /// The digits of the packed index: robot memory, robot placements, each movable's.
+    fn placements(p: &Problem) -> Vec<u64> {
         let g = &p.grid;
         let count = |cells: &[(i32, i32)], orients: u8| -> u64 {
             let mut n = 0u64;
@@ -129,10 +147,10 @@ impl Model {
             n
         };
         let aux = if p.metric.needs_memory() { 8 } else { 1 };
-        let mut n: u64 = aux * count(&p.robot.cells(), 1);
+        let mut digits = vec![aux, count(&p.robot.cells(), 1)];
         for m in &p.movables {
-            n = n.saturating_mul(count(&m.cells, if m.rotates { 4 } else { 1 }));
+            digits.push(count(&m.cells, if m.rotates { 4 } else { 1 }));
         }
-        n
+        digits
     }
 }

@@ -88,16 +88,20 @@ fn uses_bitset(ring: usize, n: usize) -> bool {
 }
 
 /// Bytes a cost map over `n_states` configurations with moves up to `max_edge` needs at its
-/// peak: the cost array, and the wave front (its bit sets, or vectors bounded by the same budget).
+/// peak: the cost array, and the wave front (its bit sets, or vectors bounded by the same
+/// budget). Saturates at `u64::MAX`.
 pub fn map_bytes_estimate(n_states: u64, max_edge: u32) -> u64 {
-    let n = n_states as usize;
-    let ring = max_edge as usize + 1;
-    let cost = n_states * std::mem::size_of::<u16>() as u64;
-    if uses_bitset(ring, n) {
-        cost + BitRing::bytes(ring, n)
+    let n = n_states as u128;
+    let ring = max_edge as u128 + 1;
+    let cost = n * std::mem::size_of::<u16>() as u128;
+    let words = n.div_ceil(64);
+    let bits = ring * (words + words.div_ceil(64)) * 8;
+    let front = if bits <= BITSET_BUDGET as u128 * cost {
+        bits
     } else {
-        cost + (BITSET_BUDGET * n * std::mem::size_of::<u16>()) as u64
-    }
+        BITSET_BUDGET as u128 * cost
+    };
+    u64::try_from(cost + front).unwrap_or(u64::MAX)
 }
 
 /// Build the cost map from an explicit goal set (packed indices in CCF).
