@@ -6,21 +6,20 @@
 //! pushed into it: its contents are fixed, and its indices can be split among the cores, each of
 //! which pushes the origins it relaxes into the *other* buckets. Two shapes of bucket:
 //! - [`BitRing`]: each bucket a two-level bit set over the whole space (atomic words, so that
-//!   two cores may set bits side by side); inserting is setting a bit, duplicates vanish, and a
+//!   two cores may set bits side by side, in pages allocated when first written); inserting is setting a bit, duplicates vanish, and a
 //!   bucket is swept in index order for free, so the scattered front visits the cost array in
 //!   one forward pass per cost;
 //! - [`VecRing`]: each bucket a vector, sorted by index when large; each core collects its pushes
 //!   locally and they are appended after the sweep (for metrics with expensive moves, where a
 //!   bit set per bucket would outweigh the cost array).
 
+use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 use rayon::prelude::*;
 
 /// Buckets larger than this are sorted by index before they are swept.
 const SORT_MIN: usize = 4096;
-/// Summary words (of 4096 indices each) per task when a bit-set bucket is swept.
-const BIT_TASK: usize = 4;
 /// Indices per task when a vector bucket is swept.
 const VEC_TASK: usize = 2048;
 
@@ -66,10 +65,14 @@ pub(super) trait Front: Sync + Sized {
     fn peak_bytes(&self) -> u64;
 }
 
-/// One bit-set bucket: `words` holds one bit per index, `summary` one bit per non-zero word.
+/// Words of one page of a bit-set bucket (4 KiB): pages are allocated when first written, so
+/// the parts of the space the wave front never reaches take no memory.
+const PAGE_WORDS: usize = 512;
+
+/// One bit-set bucket: `pages` hold one bit per index, `summary` one bit per non-zero word.
 #[derive(Default)]
 struct BitBucket {
-    words: Vec<AtomicU64>,
+    pages: Vec<OnceLock<Box<[AtomicU64]>>>,
     summary: Vec<AtomicU64>,
 }
 
@@ -82,22 +85,28 @@ impl BitRing {
     /// `ring` empty buckets over `n` indices.
     pub fn new(ring: usize, n: usize) -> BitRing {
         let nw = n.div_ceil(64);
-        let zeros = |k: usize| (0..k).map(|_| AtomicU64::new(0)).collect();
         BitRing {
             buckets: (0..ring)
                 .map(|_| BitBucket {
-                    words: zeros(nw),
-                    summary: zeros(nw.div_ceil(64)),
+                    pages: (0..nw.div_ceil(PAGE_WORDS))
+                        .map(|_| OnceLock::new())
+                        .collect(),
+                    summary: (0..nw.div_ceil(64)).map(|_| AtomicU64::new(0)).collect(),
                 })
                 .collect(),
         }
     }
 
-    /// Bytes of `ring` buckets over `n` indices.
+    /// Most bytes of `ring` buckets over `n` indices (every page written).
     pub fn bytes(ring: usize, n: usize) -> u64 {
         let nw = n.div_ceil(64);
         (ring * (nw + nw.div_ceil(64)) * 8) as u64
     }
+}
+
+/// A page of zero words.
+fn new_page() -> Box<[AtomicU64]> {
+    (0..PAGE_WORDS).map(|_| AtomicU64::new(0)).collect()
 }
 
 impl Front for BitRing {
@@ -107,7 +116,7 @@ impl Front for BitRing {
         let bucket = &self.buckets[b];
         let w = idx as usize >> 6;
         let bit = 1u64 << (idx & 63);
-        let word = &bucket.words[w];
+        let word = &bucket.pages[w / PAGE_WORDS].get_or_init(new_page)[w % PAGE_WORDS];
         if word.load(Relaxed) & bit != 0 {
             return;
         }
@@ -128,12 +137,15 @@ impl Front for BitRing {
         let this = &*self;
         let tally = bucket
             .summary
-            .par_chunks_mut(BIT_TASK)
-            .zip(bucket.words.par_chunks_mut(BIT_TASK * 64))
+            .par_chunks_mut(PAGE_WORDS / 64)
+            .zip(bucket.pages.par_iter_mut())
             .enumerate()
-            .map(|(k, (summary, words))| {
-                let base = k * BIT_TASK * 64 * 64;
+            .map(|(k, (summary, page))| {
                 let mut t = Tally::default();
+                let Some(words) = page.get_mut() else {
+                    return t;
+                };
+                let base = k * PAGE_WORDS * 64;
                 let mut local = ();
                 let mut origins = Vec::with_capacity(64);
                 for (si, s) in summary.iter_mut().enumerate() {
@@ -159,7 +171,13 @@ impl Front for BitRing {
     fn peak_bytes(&self) -> u64 {
         self.buckets
             .iter()
-            .map(|b| (b.words.len() + b.summary.len()) as u64 * 8)
+            .map(|b| {
+                let pages = b.pages.iter().filter(|p| p.get().is_some()).count();
+                (pages * PAGE_WORDS * 8
+                    + b.summary.len() * 8
+                    + b.pages.len() * std::mem::size_of::<OnceLock<Box<[AtomicU64]>>>())
+                    as u64
+            })
             .sum()
     }
 }

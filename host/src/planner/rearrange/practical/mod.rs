@@ -44,7 +44,7 @@ impl Options {
             Options {
                 weight: 1.0,
                 parkings: 3,
-                max_expansions: 3000,
+                max_expansions: 20000,
             }
         } else {
             Options {
