@@ -25,7 +25,10 @@
 //! wave front adds one bit per configuration per bucket (`max_edge + 1` buckets, 24 MB for the
 //! 2-box room). Time is bounded by cache misses on the cost array: the wave front is scattered,
 //! so each bucket is swept in index order (a bit set) and the map is visited in one forward pass
-//! per cost. Plan costs must stay below 65 535.
+//! per cost, the configurations of one cost split among the cores. Plan costs must stay below
+//! 65 535. Packed indices are `u32`: at most 2³² − 1 configurations (8 GiB of map); [`budget`]
+//! sizes a map before it is built and refuses one that would not fit, and the [`practical`]
+//! mode takes what the exact map cannot.
 
 pub mod admissibility;
 pub mod budget;
