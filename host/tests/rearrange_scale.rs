@@ -6,7 +6,7 @@ use pushbot::planner::rearrange::budget::{ExactBudget, TooLarge};
 use pushbot::planner::rearrange::cases::load_scene;
 use pushbot::planner::rearrange::practical::{Action, Options, plan_practical};
 use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
-use pushbot::planner::rearrange::{Model, cost_map, map_bytes_estimate};
+use pushbot::planner::rearrange::{Model, cost_map, map_bytes_estimate, replay_cost};
 
 #[test]
 fn the_memory_estimate_is_what_the_map_takes() {
@@ -85,6 +85,29 @@ fn the_warehouse_is_planned_legally_move_by_move() {
         assert_eq!(Some(*m), *g);
     }
     assert_eq!(plan.cost, plan.moves.iter().map(|m| m.cost).sum::<u32>());
+}
+
+#[test]
+fn practical_plans_of_the_paper_cases_are_legal_and_no_cheaper_than_the_optimum() {
+    for case in ["A1", "A2", "A3", "A4", "B1", "B2", "C1", "C2", "D1"] {
+        let p = load_scene(case).unwrap();
+        let model = Model::new(&p).unwrap();
+        let map = cost_map(&model).unwrap();
+        let opt = map.get(model.pack(&p.start).unwrap()).unwrap();
+        let plan = plan_practical(&p, &Options::for_problem(&p)).unwrap();
+        let configs: Vec<_> = plan.moves.iter().map(|m| m.config.clone()).collect();
+        // Legal under the full problem's rules (A4's distance limit included), at its cost.
+        assert_eq!(
+            replay_cost(&model, &p.start, &configs),
+            Some(plan.cost),
+            "{case}"
+        );
+        let end = configs.last().unwrap();
+        for (m, g) in end.movables.iter().zip(&p.goal_movables) {
+            assert!(g.is_none_or(|g| g == *m), "{case}");
+        }
+        assert!(plan.cost >= opt, "{case}: {} < {opt}", plan.cost);
+    }
 }
 
 fn pushbot(args: &[&str]) -> (i32, String, String) {

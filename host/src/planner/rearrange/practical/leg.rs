@@ -126,6 +126,12 @@ pub fn legs(
     let mut parked: Vec<u32> = Vec::new();
     let start_place = i.map(|_| sub.start.movables[0]);
     let mut need_direct = want.target.is_some() || want.robot_target.is_some();
+    // The others are obstacles here, but a distance limit (§IV-B) still binds the robot to them.
+    let others: Vec<(i32, i32)> = (0..cur.movables.len())
+        .filter(|&j| Some(j) != i)
+        .map(|j| (cur.movables[j].x, cur.movables[j].y))
+        .collect();
+    let limit = p.rules.distance_limit;
     dist[start as usize] = 0;
     heap.push(Reverse((0u32, start)));
     let mut nb = Vec::new();
@@ -161,6 +167,15 @@ pub fn legs(
         }
         model.neighbours(s, &mut nb);
         for step in &nb {
+            if let Some(l) = limit {
+                let rp = model.robot.place[model.decode(step.to).r as usize];
+                let far = |&(x, y): &(i32, i32)| {
+                    (rp.x - x).unsigned_abs() + (rp.y - y).unsigned_abs() > l
+                };
+                if others.iter().any(far) {
+                    continue;
+                }
+            }
             let nc = c + step.cost;
             if nc < dist[step.to as usize] {
                 dist[step.to as usize] = nc;

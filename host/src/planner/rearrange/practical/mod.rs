@@ -11,7 +11,8 @@
 //! Nodes are expanded best-first on g + w·h, where h sums, over the movables not at their goals,
 //! the anchor's Manhattan distance times the cheapest push (a lower bound for translational
 //! pushes; rotations may shift the anchor further). The plan is legal under the full problem's
-//! rules except a distance limit, which the legs do not see; it is not proven optimal. When the
+//! rules (a distance limit binds the robot to the movables held fixed too); it pushes one
+//! movable at a time, and it is not proven optimal. When the
 //! search ends without a plan it says "no plan found", unless some movable cannot reach its goal
 //! even alone on the table, which proves that no plan exists (one movable pushed at a time, no
 //! distance limit).
