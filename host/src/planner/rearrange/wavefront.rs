@@ -140,6 +140,9 @@ impl Front for BitRing {
             .par_chunks_mut(PAGE_WORDS / 64)
             .zip(bucket.pages.par_iter_mut())
             .enumerate()
+            // One page per job: the front of one cost gathers in a few parts of the space, and
+            // rayon's adaptive splitting alone would leave such a part to one core.
+            .with_max_len(1)
             .map(|(k, (summary, page))| {
                 let mut t = Tally::default();
                 let Some(words) = page.get_mut() else {
@@ -226,6 +229,7 @@ impl Front for VecRing {
         let this = &*self;
         let parts: Vec<(Vec<(u32, u32)>, Tally)> = bucket
             .par_chunks(VEC_TASK)
+            .with_max_len(1)
             .map(|chunk| {
                 let mut t = Tally::default();
                 let mut local = Vec::new();
