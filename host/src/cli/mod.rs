@@ -132,7 +132,8 @@ pub enum PlanCommand {
 /// `pushbot bench …`.
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
-    /// Cost-map building of the rearrangement planner on large rooms.
+    /// The rearrangement planner on large rooms: the exact cost map on every core (time, states/s,
+    /// cores busy, peak memory) and the practical mode (its cost over the optimum).
     Rearrange(rearrange::BenchArgs),
     /// Plan time of the stable-pushing presets next to the paper's.
     Stable(stable::BenchStableArgs),

@@ -1,16 +1,26 @@
 //! `pushbot plan rearrange` and `pushbot bench rearrange`: Ben-Shahar & Rivlin rearrangement
 //! planning (see `planner::rearrange`).
 
-use std::time::Instant;
-
 use clap::Args;
 use serde_json::json;
 
 use super::{CliError, CliResult, Global, Status};
-use crate::planner::rearrange::{
-    self, Config, Dir, Grid, Metric, Model, MovableSpec, MoveKind, Placement, Problem,
-    RestoreError, RobotSpec, Rules, cases,
-};
+use crate::experiments::rearrange_bench::{self, peak_kib};
+use crate::planner::rearrange::budget::{ExactBudget, human};
+use crate::planner::rearrange::practical::{self, Action, Options, PracticalError};
+use crate::planner::rearrange::{self, Model, MoveKind, Problem, RestoreError, cases};
+
+/// Which planner `plan rearrange` uses.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// The exact planner when its cost map fits in memory, else the practical mode.
+    #[default]
+    Auto,
+    /// The exact cost map (optimal; refused when it would not fit).
+    Exact,
+    /// The object-level search over single-object legs (many movables; not proven optimal).
+    Practical,
+}
 
 /// Arguments of `pushbot plan rearrange`.
 #[derive(Args, Debug, Clone)]
@@ -25,6 +35,10 @@ pub struct PlanArgs {
     /// Write the same figures as a PNG picture to this file.
     #[arg(long)]
     pub png: Option<std::path::PathBuf>,
+    /// The planner: `exact` (optimal), `practical` (many movables) or `auto` (exact when its
+    /// map fits in memory).
+    #[arg(long, value_enum, default_value_t = Mode::Auto)]
+    pub mode: Mode,
 }
 
 /// Arguments of `pushbot bench rearrange`.
@@ -33,26 +47,12 @@ pub struct BenchArgs {
     /// Small rooms (10 × 10 with 2 boxes, 8 × 8 with 3) for a quick check.
     #[arg(long)]
     pub quick: bool,
-    /// Run only this benchmark: `2box` or `3box`.
+    /// Run only this benchmark: `2box`, `3box`, `4box` or `12box`.
     #[arg(long)]
     pub only: Option<String>,
-}
-
-/// Peak resident memory of this process in KiB (VmHWM), if the system tells.
-pub fn peak_kib() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
-    line.split_whitespace().nth(1)?.parse().ok()
-}
-
-/// CPU time of this thread in ms (utime + stime from /proc, 10 ms resolution), if the system
-/// tells; on a shared machine it is the fairer measure of the map's cost than wall time.
-pub fn thread_cpu_ms() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    let rest = &s[s.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: u64 = f.get(11)?.parse::<u64>().ok()? + f.get(12)?.parse::<u64>().ok()?;
-    Some(ticks as f64 * 10.0)
+    /// Skip the practical mode (time the exact map alone).
+    #[arg(long)]
+    pub exact_only: bool,
 }
 
 fn step_json(model: &Model, st: &rearrange::restore::PlanStep) -> serde_json::Value {
@@ -82,9 +82,30 @@ fn step_json(model: &Model, st: &rearrange::restore::PlanStep) -> serde_json::Va
 /// Run `pushbot plan rearrange`.
 pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
     let problem = cases::load_scene(&args.scene).map_err(CliError::bad_input)?;
+    let budget = ExactBudget::of(&problem);
+    let fits = budget.check();
+    let exact = match args.mode {
+        Mode::Exact => {
+            fits.map_err(|e| CliError::bad_input(format!("scene `{}`: {e}", args.scene)))?;
+            true
+        }
+        Mode::Practical => false,
+        Mode::Auto => fits.is_ok(),
+    };
+    if !exact {
+        return plan_practical(global, &args, &problem);
+    }
+    eprintln!(
+        "exact cost map: {} configurations, about {} ({} cores)",
+        budget.configurations,
+        human(budget.bytes),
+        rayon::current_num_threads()
+    );
     let model = Model::new(&problem)
         .map_err(|e| CliError::bad_input(format!("scene `{}`: {e}", args.scene)))?;
+    let pb = spinner(global, "cost map");
     let map = rearrange::cost_map(&model).map_err(|e| CliError::Failed(e.into()))?;
+    pb.finish_and_clear();
     let start = model.pack(&problem.start).ok_or_else(|| {
         CliError::bad_input(format!("scene `{}`: the start is not free", args.scene))
     })?;
@@ -107,6 +128,8 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
             if global.json {
                 let j = json!({
                     "scene": problem.name,
+                    "mode": "exact",
+                    "optimal": true,
                     "found": true,
                     "cost": p.cost,
                     "steps": p.steps.len(),
@@ -162,7 +185,9 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
             if global.json {
                 let j = json!({
                     "scene": problem.name,
+                    "mode": "exact",
                     "found": false,
+                    "proven": true,
                     "reason": e.to_string(),
                     "states_total": st.states_total,
                     "states_mapped": st.states_mapped,
@@ -185,113 +210,200 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
     }
 }
 
-/// A benchmark room: `side × side`, no inner obstacles, the robot and `boxes` one-cell boxes of
-/// mass 1, one box at a time; goals in a row along the bottom, the robot anywhere.
-pub fn bench_problem(side: i32, boxes: usize) -> Problem {
-    let movables: Vec<MovableSpec> = (0..boxes)
-        .map(|i| MovableSpec::with_faces(&format!("b{i}"), vec![(0, 0)], 1))
-        .collect();
-    let starts = (0..boxes)
-        .map(|i| Placement {
-            x: 2 + 2 * i as i32,
-            y: 2,
-            o: 0,
-        })
-        .collect();
-    let goals = (0..boxes)
-        .map(|i| {
-            Some(Placement {
-                x: side - 3 - 2 * i as i32,
-                y: side - 3,
-                o: 0,
-            })
-        })
-        .collect();
-    Problem {
-        name: format!("{boxes}box-{side}x{side}"),
-        grid: Grid::new(side, side),
-        robot: RobotSpec { size: 1, mass: 1 },
-        movables,
-        rules: Rules::default(),
-        metric: Metric::default(),
-        start: Config {
-            robot: (0, 0),
-            heading: Dir::E,
-            pushing: false,
-            movables: starts,
-        },
-        goal_robot: None,
-        goal_movables: goals,
+/// `plan rearrange` in the practical mode: the same JSON fields as the exact planner's (those
+/// of the map are null), plus `optimal`.
+fn plan_practical(global: &Global, args: &PlanArgs, problem: &Problem) -> CliResult {
+    if args.svg.is_some() || args.png.is_some() {
+        return Err(CliError::bad_input(
+            "--svg and --png draw plans of the exact planner; use --mode exact",
+        ));
     }
+    if !global.json {
+        eprintln!(
+            "practical mode: {} movables (the exact map would take {} configurations, {})",
+            problem.movables.len(),
+            budget_text(problem),
+            human(ExactBudget::of(problem).bytes)
+        );
+    }
+    let pb = spinner(global, "object-level search");
+    let result = practical::plan_practical(problem, &Options::for_problem(problem));
+    pb.finish_and_clear();
+    let peak = peak_kib();
+    match result {
+        Ok(p) => {
+            let name = |i: usize| problem.movables[i].name.clone();
+            let steps: Vec<serde_json::Value> = p
+                .moves
+                .iter()
+                .map(|m| {
+                    let (kind, pushed, turn) = match m.action {
+                        Action::Transit => ("transit", vec![], 0),
+                        Action::Push(i) => ("push", vec![name(i)], 0),
+                        Action::Rotate(i, t) => ("rotate", vec![name(i)], t),
+                    };
+                    let c = &m.config;
+                    json!({
+                        "dir": m.dir.letter().to_string(),
+                        "kind": kind,
+                        "pushed": pushed,
+                        "turn": turn,
+                        "cost": m.cost,
+                        "robot": [c.robot.0, c.robot.1],
+                        "movables": c.movables.iter().map(|p| json!([p.x, p.y, p.o])).collect::<Vec<_>>(),
+                    })
+                })
+                .collect();
+            if global.json {
+                let j = json!({
+                    "scene": problem.name,
+                    "mode": "practical",
+                    "optimal": p.optimal,
+                    "found": true,
+                    "cost": p.cost,
+                    "steps": p.moves.len(),
+                    "pushes": p.pushes(),
+                    "legs": p.legs,
+                    "expansions": p.expansions,
+                    "states_total": null,
+                    "states_mapped": p.settled,
+                    "map_ms": null,
+                    "plan_ms": p.plan_ms,
+                    "restore_ms": 0.0,
+                    "map_bytes": null,
+                    "peak_kib": peak,
+                    "plan": steps,
+                });
+                println!("{j}");
+            } else {
+                println!(
+                    "{}: cost {} (not proven optimal), {} steps, {} pushes in {} legs; {} object-level nodes in {:.1} ms",
+                    problem.name,
+                    p.cost,
+                    p.moves.len(),
+                    p.pushes(),
+                    p.legs,
+                    p.expansions,
+                    p.plan_ms
+                );
+                let line: String = p
+                    .moves
+                    .iter()
+                    .map(|m| match m.action {
+                        Action::Transit => format!(" {}", m.dir.letter()),
+                        Action::Push(i) => format!(" {}[{}]", m.dir.letter(), name(i)),
+                        Action::Rotate(i, t) => format!(
+                            " {}[{} {}]",
+                            m.dir.letter(),
+                            name(i),
+                            if t > 0 { "cw" } else { "ccw" }
+                        ),
+                    })
+                    .collect();
+                println!(" {line}");
+            }
+            Ok(Status::Success)
+        }
+        Err(PracticalError::Problem(e)) => {
+            Err(CliError::bad_input(format!("scene `{}`: {e}", args.scene)))
+        }
+        Err(e) => {
+            let proven = matches!(e, PracticalError::NoPlanExists(_));
+            if global.json {
+                let j = json!({
+                    "scene": problem.name,
+                    "mode": "practical",
+                    "found": false,
+                    "proven": proven,
+                    "reason": e.to_string(),
+                    "peak_kib": peak,
+                });
+                println!("{j}");
+            } else {
+                println!("{}: {e}", problem.name);
+            }
+            Ok(Status::TaskFailed)
+        }
+    }
+}
+
+/// A spinner on stderr while long work runs (hidden with `--json` and off a terminal).
+fn spinner(global: &Global, what: &str) -> indicatif::ProgressBar {
+    if global.json {
+        return indicatif::ProgressBar::hidden();
+    }
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message(what.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
+/// The exact map's configurations as text.
+fn budget_text(problem: &Problem) -> String {
+    format!("{:.2e}", ExactBudget::of(problem).configurations_f64)
 }
 
 /// Run `pushbot bench rearrange`.
 pub fn bench(global: &Global, args: BenchArgs) -> CliResult {
-    let mut runs = vec![
-        ("2box", if args.quick { 10 } else { 20 }, 2),
-        ("3box", if args.quick { 8 } else { 12 }, 3),
-    ];
+    let mut runs = rearrange_bench::instances(args.quick);
     if let Some(only) = &args.only {
-        runs.retain(|r| r.0 == only);
+        runs.retain(|r| r.key == only);
         if runs.is_empty() {
             return Err(CliError::bad_input(format!(
-                "--only {only}: use 2box or 3box"
+                "--only {only}: use 2box, 3box, 4box or 12box"
             )));
         }
     }
-    let mut results = Vec::new();
-    for (_, side, boxes) in runs {
-        let problem = bench_problem(side, boxes);
-        let t0 = Instant::now();
-        let model = Model::new(&problem).map_err(|e| CliError::Failed(e.into()))?;
-        let build_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let cpu0 = thread_cpu_ms();
-        let map = rearrange::cost_map(&model).map_err(|e| CliError::Failed(e.into()))?;
-        let map_cpu_ms = thread_cpu_ms().zip(cpu0).map(|(b, a)| b - a);
-        let start = model
-            .pack(&problem.start)
-            .ok_or_else(|| CliError::Failed(anyhow::anyhow!("bench start")))?;
-        let plan = rearrange::restore(&model, &map, start);
-        let st = map.stats;
-        let (cost, restore_ms) = match &plan {
-            Ok(p) => (Some(p.cost), Some(p.restore_ms)),
-            Err(_) => (None, None),
-        };
-        let j = json!({
-            "name": problem.name,
-            "states_total": st.states_total,
-            "states_mapped": st.states_mapped,
-            "relaxations": st.relaxations,
-            "tables_ms": build_ms,
-            "map_ms": st.map_ms,
-            "map_cpu_ms": map_cpu_ms,
-            "states_per_s": st.states_mapped as f64 / (st.map_ms / 1e3).max(1e-9),
-            "states_per_cpu_s": map_cpu_ms.map(|c| st.states_mapped as f64 / (c / 1e3).max(1e-9)),
-            "configs_per_s": st.states_total as f64 / (st.map_ms / 1e3).max(1e-9),
-            "map_bytes": st.map_bytes,
-            "peak_kib": peak_kib(),
-            "cost": cost,
-            "restore_ms": restore_ms,
-        });
+    let mut rows = Vec::new();
+    for inst in &runs {
+        let row = rearrange_bench::run(inst, !args.exact_only);
         if !global.json {
-            println!(
-                "{}: {} configurations, {} mapped in {:.0} ms wall, {:.0} ms CPU ({:.2e} mapped/s), map {} MiB, peak {} KiB, plan cost {:?}",
-                problem.name,
-                st.states_total,
-                st.states_mapped,
-                st.map_ms,
-                map_cpu_ms.unwrap_or(f64::NAN),
-                st.states_mapped as f64 / (st.map_ms / 1e3).max(1e-9),
-                st.map_bytes >> 20,
-                peak_kib().unwrap_or(0),
-                cost
-            );
+            print_row(&row);
         }
-        results.push(j);
-        drop(map);
+        rows.push(row);
     }
     if global.json {
-        println!("{}", serde_json::Value::Array(results));
+        println!(
+            "{}",
+            serde_json::to_value(&rows).map_err(|e| CliError::Failed(e.into()))?
+        );
     }
     Ok(Status::Success)
+}
+
+/// One bench row as text.
+fn print_row(r: &rearrange_bench::Row) {
+    let opt =
+        |v: Option<f64>, unit: &str| v.map_or("–".to_string(), |v| format!("{v:.0} {unit}"));
+    println!(
+        "{}: {} movables, {:.3e} configurations (exact map ≈ {})",
+        r.name,
+        r.movables,
+        r.configurations,
+        human(r.map_bytes_estimate)
+    );
+    match &r.exact_refused {
+        Some(why) => println!("  exact: refused: {why}"),
+        None => println!(
+            "  exact: {} wall, {} CPU ({:.2} cores), {:.2e} states/s, map {}, peak {} MiB, cost {}",
+            opt(r.map_ms, "ms"),
+            opt(r.map_cpu_ms, "ms"),
+            r.cores_busy.unwrap_or(f64::NAN),
+            r.states_per_s.unwrap_or(f64::NAN),
+            human(r.map_bytes.unwrap_or(0)),
+            r.peak_kib.unwrap_or(0) >> 10,
+            r.cost.map_or("none".to_string(), |c| c.to_string())
+        ),
+    }
+    match r.practical_cost {
+        Some(c) => println!(
+            "  practical: cost {c}{} in {}, {} object-level nodes",
+            r.practical_over_optimum
+                .map_or(String::new(), |q| format!(" ({q:.3}× the optimum)")),
+            opt(r.practical_ms, "ms"),
+            r.practical_expansions.unwrap_or(0)
+        ),
+        None if r.practical_ms.is_none() => println!("  practical: no plan found or not run"),
+        None => {}
+    }
 }

@@ -7,6 +7,8 @@
 //!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
+//! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
+//!   planner on large rooms (`pushbot bench rearrange`).
 //! - `link_bench`: commands through a faulty wire to the in-process target (`pushbot bench
 //!   link`).
 
@@ -16,6 +18,7 @@ pub mod delivery;
 pub mod demo;
 #[cfg(feature = "sim")]
 pub mod link_bench;
+pub mod rearrange_bench;
 #[cfg(feature = "sim")]
 pub mod strategy_eval;
 pub mod trials;

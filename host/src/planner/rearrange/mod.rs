@@ -6,7 +6,11 @@
 //!   integer indices;
 //! - [`admissibility`]: admissible neighbours and origins, §IV-B, computed on the fly;
 //! - [`metric`]: the cost metrics of §IV-C (mass, safety, passability, contact-mode changes, turns);
-//! - [`costmap`]: the cost mapping phase, §IV-A1 (backward propagation from a goal set);
+//! - [`costmap`]: the cost mapping phase, §IV-A1 (backward propagation from a goal set), on
+//!   every core; its wave front in `wavefront`;
+//! - [`budget`]: the memory the exact map needs, known before it is built (§IV-E);
+//! - [`practical`]: the practical mode for many movables, an object-level search over exact
+//!   single-object legs;
 //! - [`restore`]: the pushing C-path restoration phase, §IV-A2;
 //! - [`cases`]: the test cases A–D of §V-A (scene presets) and reading scenes;
 //! - [`scene`]: the shared scene format (`[rearrange]` section) rasterised to a grid problem;
@@ -21,15 +25,21 @@
 //! wave front adds one bit per configuration per bucket (`max_edge + 1` buckets, 24 MB for the
 //! 2-box room). Time is bounded by cache misses on the cost array: the wave front is scattered,
 //! so each bucket is swept in index order (a bit set) and the map is visited in one forward pass
-//! per cost. Plan costs must stay below 65 535.
+//! per cost, the configurations of one cost split among the cores. Plan costs must stay below
+//! 65 535. Packed indices are `u32`: at most 2³² − 1 configurations (8 GiB of map); [`budget`]
+//! sizes a map before it is built and refuses one that would not fit, and the [`practical`]
+//! mode takes what the exact map cannot.
 
 pub mod admissibility;
+pub mod budget;
 pub mod cases;
 pub mod costmap;
+mod wavefront;
 
 pub mod frame;
 pub mod grid;
 pub mod metric;
+pub mod practical;
 pub mod problem;
 pub mod restore;
 pub mod scene;
@@ -37,7 +47,7 @@ pub mod svg;
 pub mod to_scene;
 
 pub use admissibility::{MoveKind, Step};
-pub use costmap::{CostMap, INF, MapError, MapStats, cost_map};
+pub use costmap::{CostMap, INF, MapError, MapStats, cost_map, map_bytes_estimate};
 pub use metric::Metric;
 pub use problem::{
     Config, ContactMode, Dir, Grid, Model, MovableSpec, Placement, Problem, RobotSpec, Rules,
