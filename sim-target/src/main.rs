@@ -77,6 +77,11 @@ struct Cli {
     /// How long each unplug lasts, s of simulated time.
     #[arg(long, value_name = "S", default_value_t = 1.0, requires = "unplug_at")]
     unplug_for: f64,
+    /// Move an object by hand mid-run (repeatable): `AT:OBJECT:DX:DY[:DTHETA_DEG]` — at AT
+    /// seconds of simulated time, put OBJECT down DX, DY metres (and DTHETA degrees) from where
+    /// it is, e.g. `--disturb 40:box1:0.1:0`.
+    #[arg(long, value_name = "AT:OBJECT:DX:DY")]
+    disturb: Vec<pushbot_sim::sim::Disturbance>,
     /// Run until killed instead of until standard input closes.
     #[arg(long)]
     no_stdin: bool,
@@ -293,10 +298,18 @@ fn run(cli: Cli) -> Result<()> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    if let Some(d) = cli.disturb.iter().find(|d| {
+        !scene
+            .as_ref()
+            .is_some_and(|s| s.objects.iter().any(|o| o.id == d.object))
+    }) {
+        bad_input!("--disturb: the scene has no object {:?} to move", d.object);
+    }
     let opts = SimOptions {
         faults,
         link: cli.link.clone(),
         unplugs,
+        disturbances: cli.disturb.clone(),
         scene: scene.clone(),
         seed: cli.seed,
         speed: cli.speed,

@@ -59,6 +59,54 @@ pub struct SimOptions {
     pub link: Option<PathBuf>,
     /// Unplugs of the served port ([`crate::PtySim`] only; needs `link`).
     pub unplugs: Vec<crate::plug::Unplug>,
+    /// Objects moved by hand at given times ([`Disturbance`]).
+    pub disturbances: Vec<Disturbance>,
+}
+
+/// An object moved by hand mid-run (issue 22): at `at_s` seconds of simulated time `object` is
+/// lifted and put down `by` (dx, dy in metres, dθ in radians, table frame) from where it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disturbance {
+    /// When, s of simulated time.
+    pub at_s: f64,
+    /// Which object (its scene id).
+    pub object: String,
+    /// How far: dx, dy (m), dθ (rad).
+    pub by: [f64; 3],
+}
+
+impl std::str::FromStr for Disturbance {
+    type Err = String;
+
+    /// `AT:OBJECT:DX:DY[:DTHETA_DEG]`, e.g. `40:box1:0.1:0` (seconds, metres, degrees).
+    fn from_str(s: &str) -> Result<Disturbance, String> {
+        let parts: Vec<&str> = s.split(':').collect();
+        if !(4..=5).contains(&parts.len()) || parts[1].is_empty() {
+            return Err(format!(
+                "{s:?}: a disturbance is AT:OBJECT:DX:DY[:DTHETA_DEG], e.g. 40:box1:0.1:0"
+            ));
+        }
+        let num = |k: usize, what: &str| -> Result<f64, String> {
+            parts
+                .get(k)
+                .map_or(Ok(0.0), |v| v.parse::<f64>())
+                .map_err(|_| format!("{s:?}: {what} {:?} is not a number", parts[k]))
+                .and_then(|v| {
+                    v.is_finite()
+                        .then_some(v)
+                        .ok_or_else(|| format!("{s:?}: {what} must be finite"))
+                })
+        };
+        let at_s = num(0, "the time")?;
+        if at_s < 0.0 {
+            return Err(format!("{s:?}: the time must not be negative"));
+        }
+        Ok(Disturbance {
+            at_s,
+            object: parts[1].to_string(),
+            by: [num(2, "dx")?, num(3, "dy")?, num(4, "dθ")?.to_radians()],
+        })
+    }
 }
 
 impl Default for SimOptions {
@@ -79,6 +127,7 @@ impl Default for SimOptions {
             camera: None,
             link: None,
             unplugs: Vec::new(),
+            disturbances: Vec::new(),
         }
     }
 }
@@ -129,6 +178,8 @@ pub struct Sim {
     starts: BTreeMap<u16, u32>,
     starts_since_boot: BTreeMap<u16, u32>,
     watchdog_trips: u64,
+    /// Disturbances still to come, soonest last.
+    disturbances: Vec<Disturbance>,
 }
 
 impl Sim {
@@ -173,6 +224,11 @@ impl Sim {
             starts: BTreeMap::new(),
             starts_since_boot: BTreeMap::new(),
             watchdog_trips: 0,
+            disturbances: {
+                let mut d = opts.disturbances.clone();
+                d.sort_by(|a, b| b.at_s.total_cmp(&a.at_s));
+                d
+            },
         })
     }
 
@@ -257,6 +313,26 @@ impl Sim {
             self.world.step(self.duty, dt);
         }
         self.now_us += u64::from(self.tick_us);
+        while self
+            .disturbances
+            .last()
+            .is_some_and(|d| d.at_s * 1e6 <= self.now_us as f64)
+        {
+            if let Some(d) = self.disturbances.pop() {
+                if self.world.shift_object(&d.object, d.by) {
+                    tracing::info!(
+                        "disturbance at {:.2} s: {} moved by ({:+.3}, {:+.3}) m, {:+.1}°",
+                        d.at_s,
+                        d.object,
+                        d.by[0],
+                        d.by[1],
+                        d.by[2].to_degrees()
+                    );
+                } else {
+                    tracing::warn!("disturbance at {:.2} s: no object {:?}", d.at_s, d.object);
+                }
+            }
+        }
     }
 
     /// Run whole ticks until at least `seconds` more of simulated time have passed.

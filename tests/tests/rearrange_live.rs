@@ -63,3 +63,71 @@ fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
     drop(robot);
     t.shutdown().expect("sim ran cleanly");
 }
+
+/// A box moved by hand mid-run (the simulator's disturbance: box `b` put down 10 cm off its
+/// row): the executor sees it off the cell the plan had put it in, re-plans from where it is (a
+/// lookup in the same cost map), says so in its report, and still brings both boxes home.
+#[test]
+fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
+    use pushbot::sim::target::Disturbance;
+    pushbot_tests::init_logging();
+    let _limit = pushbot_tests::WallLimit::arm(
+        "a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is",
+        std::time::Duration::from_secs(10 * 60),
+    );
+    let p = load_scene("A1").expect("preset");
+    let model = Model::new(&p).expect("model");
+    let map = cost_map(&model).expect("map");
+    let so = SceneOptions::default();
+    let scene = scene_for(&p, &so).expect("scene");
+    let disturb: Disturbance = "25:b:0:0.1".parse().expect("a disturbance");
+    let t = SimTarget::start_with(&scene, 12, SIM_SPEED, None, None, vec![disturb])
+        .expect("start the simulated target");
+    let opts = LiveOptions {
+        watchdog_ms: (1000.0 * SIM_SPEED) as u16,
+        boundary_inset: 0.0,
+        ..LiveOptions::default()
+    };
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, opts).expect("connect");
+    assert!(t.sim().truth().t < 25.0, "connecting took 5 s of wall time");
+    let report = execute(&model, &map, &mut robot, &ExecOptions::default()).expect("execute");
+    eprintln!("{report:?}");
+    assert!(report.reached, "{report:?}");
+    assert!(
+        t.sim().truth().t > 25.0,
+        "the run ended before the hand came"
+    );
+    let moved_b = report
+        .replans
+        .iter()
+        .find(|r| r.moved.iter().any(|(name, a, b)| name == "b" && a.1 != b.1));
+    assert!(
+        moved_b.is_some(),
+        "no re-plan saw box b off its row: {:?}",
+        report.replans
+    );
+    let frame = GridFrame {
+        cell: so.cell,
+        h: p.grid.h,
+    };
+    let truth = t.sim().objects();
+    for (m, g) in p.movables.iter().zip(&p.goal_movables) {
+        let g = g.expect("A1 gives every box a goal");
+        let (_, pose) = truth
+            .iter()
+            .find(|(id, _)| *id == m.name)
+            .expect("box in the sim");
+        let want = frame.centre(g.x, g.y);
+        assert!(
+            (pose.x - want.x).abs().max((pose.y - want.y).abs()) < 0.5 * so.cell,
+            "box `{}` at ({:.3}, {:.3}), goal ({:.3}, {:.3})",
+            m.name,
+            pose.x,
+            pose.y,
+            want.x,
+            want.y
+        );
+    }
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}

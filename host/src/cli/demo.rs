@@ -30,7 +30,7 @@ pub const STAGES: [&str; 3] = ["strategy", "rearrange", "stable"];
 /// `pushbot demo`.
 #[derive(Args, Debug, Clone)]
 #[command(
-    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --stages stable --foxglove 127.0.0.1:8765\n  pushbot demo --stages strategy --faults --fault-cut-every 5 --fault-cut-for 1\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml --reconnect 10 --intrinsics camera.yaml"
+    after_help = "Examples:\n  pushbot demo\n  pushbot demo --out /tmp/demo --png --stages strategy,stable\n  pushbot demo --scene strategy=lau-snake\n  pushbot demo --stages stable --foxglove 127.0.0.1:8765\n  pushbot demo --stages strategy --faults --fault-cut-every 5 --fault-cut-for 1\n  pushbot demo --stages rearrange --disturb 40:b:0:0.1\n  pushbot demo --port /dev/ttyACM0 --camera /dev/video0 --scene strategy=my-table.toml --reconnect 10 --intrinsics camera.yaml"
 )]
 pub struct DemoArgs {
     /// Folder for the report (created; files in it are replaced).
@@ -72,6 +72,12 @@ pub struct DemoArgs {
     #[cfg(feature = "sim")]
     #[command(flatten)]
     pub faults: crate::sim::target::FaultArgs,
+    /// Move a box by hand mid-run on the built-in simulated target (repeatable):
+    /// `AT:OBJECT:DX:DY[:DTHETA_DEG]`, e.g. `--disturb 40:b:0:0.1` moves box `b` 10 cm at 40 s
+    /// of simulated time; the executor re-plans from where it is, and the report lists it.
+    #[cfg(feature = "sim")]
+    #[arg(long, value_name = "AT:OBJECT:DX:DY")]
+    pub disturb: Vec<crate::sim::target::Disturbance>,
     /// Record the run into this MCAP file (default OUT/run.mcap): camera, detections, tracked
     /// poses, scene, paths, telemetry, logs, in Foxglove's schemas (open it in Foxglove, or
     /// `pushbot replay FILE`).
@@ -166,6 +172,28 @@ fn run_stages(
             "--faults injects faults on the built-in simulated target's link, not with --port",
         ));
     }
+    let movables: Vec<&str> = strategy_scene
+        .objects
+        .iter()
+        .map(|o| o.id.as_str())
+        .chain(rearrange.1.movables.iter().map(|m| m.name.as_str()))
+        .collect();
+    if let Some(d) = args
+        .disturb
+        .iter()
+        .find(|d| !movables.contains(&d.object.as_str()))
+    {
+        return Err(CliError::bad_input(format!(
+            "--disturb: no stage has an object {:?} (the objects are {})",
+            d.object,
+            movables.join(", ")
+        )));
+    }
+    if !args.disturb.is_empty() && args.port.is_some() {
+        return Err(CliError::bad_input(
+            "--disturb moves boxes on the built-in simulated target, not with --port",
+        ));
+    }
     let opts = DemoOptions {
         out: args.out.clone(),
         stages: args.stages.clone(),
@@ -180,6 +208,7 @@ fn run_stages(
         view: args.view,
         quiet: g.json,
         faults,
+        disturb: args.disturb.clone(),
         link: g.link_options()?,
         recover: !g.no_recover,
         lens: g.lens()?,

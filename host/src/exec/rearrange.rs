@@ -64,6 +64,9 @@ pub struct ExecReport {
     /// Times the observed configuration differed from the expected one (and restoration
     /// started from the observed one instead).
     pub deviations: usize,
+    /// Re-plans: observations with a movable off the cell the plan had put it in (pushed
+    /// off-grid, moved by hand), each continued from where the movables really were.
+    pub replans: Vec<Replan>,
     /// Cost of the plan from the first observation.
     pub planned_cost: u32,
     /// Cost of the moves actually carried out.
@@ -74,6 +77,19 @@ pub struct ExecReport {
     pub final_robot: (i32, i32),
     /// The movables' last observed placements.
     pub final_movables: Vec<(i32, i32, u8)>,
+}
+
+/// A re-plan: the movables were not where the plan had put them.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Replan {
+    /// Segments carried out before it.
+    pub after_segment: usize,
+    /// Each movable found off its expected cell: name, expected cell, observed cell.
+    pub moved: Vec<(String, (i32, i32), (i32, i32))>,
+    /// Cost of the rest of the plan as expected, and from where the movables were.
+    pub cost_expected: u32,
+    /// Cost from the observed configuration (an instant lookup in the cost map).
+    pub cost_observed: u32,
 }
 
 /// Observe the robot and every movable and snap them to the grid. `memory` is the robot's last
@@ -177,6 +193,7 @@ pub fn execute(
         moves: 0,
         pushes: 0,
         deviations: 0,
+        replans: Vec::new(),
         planned_cost: 0,
         executed_cost: 0,
         time_s: 0.0,
@@ -200,6 +217,16 @@ pub fn execute(
             );
         }
         let q = snap_free(model, &frame, io, q);
+        let moved: Vec<(String, (i32, i32), (i32, i32))> = match &expected {
+            Some(e) => p
+                .movables
+                .iter()
+                .zip(e.movables.iter().zip(&q.movables))
+                .filter(|(_, (a, b))| (a.x, a.y) != (b.x, b.y))
+                .map(|(m, (a, b))| (m.name.clone(), (a.x, a.y), (b.x, b.y)))
+                .collect(),
+            None => Vec::new(),
+        };
         let idx = model.pack(&q).ok_or_else(|| {
             anyhow!(
                 "the observed configuration (robot {:?}, movables {:?}) is not free on the grid",
@@ -212,6 +239,28 @@ pub fn execute(
             .ok_or_else(|| anyhow!("no pushing path exists from the observed configuration"))?;
         if report.segments == 0 {
             report.planned_cost = cost;
+        }
+        if !moved.is_empty() {
+            let cost_expected = expected
+                .as_ref()
+                .and_then(|e| model.pack(e))
+                .and_then(|i| map.get(i))
+                .unwrap_or(cost);
+            tracing::info!(
+                "re-plan after segment {}: {}; cost {cost_expected} → {cost}",
+                report.segments,
+                moved
+                    .iter()
+                    .map(|(n, a, b)| format!("`{n}` at cell {b:?}, not {a:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            report.replans.push(Replan {
+                after_segment: report.segments,
+                moved,
+                cost_expected,
+                cost_observed: cost,
+            });
         }
         if cost == 0 {
             report.reached = true;

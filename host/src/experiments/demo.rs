@@ -58,6 +58,9 @@ pub struct DemoOptions {
     /// Link faults injected between the host and the built-in simulated target (not with a
     /// real robot).
     pub faults: Option<LinkFaults>,
+    /// Objects moved by hand mid-run on the built-in simulated target (each applies in the
+    /// stages whose scene has that object).
+    pub disturb: Vec<crate::sim::target::Disturbance>,
     /// The serial link's settings (how long to wait for a port that went away).
     pub link: LinkOptions,
     /// Recover a broken link and go on (`--no-recover` turns it off).
@@ -243,8 +246,21 @@ impl Ctx<'_> {
                 if self.opts.lens.is_some() {
                     seen.camera.lens = self.opts.lens;
                 }
-                let target =
-                    SimTarget::start(&seen, self.opts.seed, speed, None, self.opts.faults)?;
+                let disturb: Vec<_> = self
+                    .opts
+                    .disturb
+                    .iter()
+                    .filter(|d| scene.objects.iter().any(|o| o.id == d.object))
+                    .cloned()
+                    .collect();
+                let target = SimTarget::start_with(
+                    &seen,
+                    self.opts.seed,
+                    speed,
+                    None,
+                    self.opts.faults,
+                    disturb,
+                )?;
                 self.log(&format!(
                     "simulated target: serial {} camera {}",
                     target.port(),
@@ -468,6 +484,14 @@ fn stage_rearrange(
     st.number("executed_cost", rep.executed_cost);
     st.number("pushes", rep.pushes);
     st.number("deviations_snapped", rep.deviations);
+    // Every re-plan: a box not where the plan had put it, continued from where it was.
+    st.number("replans", rep.replans.len());
+    if !rep.replans.is_empty() {
+        st.number(
+            "replanned_from",
+            serde_json::to_value(&rep.replans).unwrap_or_default(),
+        );
+    }
     let f = ctx.report.figure(
         "rearrange-run",
         &figure::run_svg(&scene, &trace, "executed rearrangement (truth)", true),

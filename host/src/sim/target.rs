@@ -9,6 +9,7 @@ use pushbot_sim::{PtySim, SimOptions};
 use pushbot_world::Scene;
 
 pub use pushbot_sim::faults::{FaultArgs, LinkFaults};
+pub use pushbot_sim::sim::Disturbance;
 
 /// A simulated robot and camera serving one scene.
 pub struct SimTarget {
@@ -36,10 +37,23 @@ impl SimTarget {
         frames_dir: Option<std::path::PathBuf>,
         faults: Option<LinkFaults>,
     ) -> Result<SimTarget> {
+        SimTarget::start_with(scene, seed, speed, frames_dir, faults, Vec::new())
+    }
+
+    /// As [`SimTarget::start`], with objects moved by hand mid-run (`disturbances`).
+    pub fn start_with(
+        scene: &Scene,
+        seed: u64,
+        speed: f64,
+        frames_dir: Option<std::path::PathBuf>,
+        faults: Option<LinkFaults>,
+        disturbances: Vec<Disturbance>,
+    ) -> Result<SimTarget> {
         let sim = PtySim::start(SimOptions {
             seed,
             speed,
             faults,
+            disturbances,
             scene: Some(scene.clone()),
             camera: Some(LiveCameraOptions {
                 frames_dir,

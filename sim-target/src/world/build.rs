@@ -169,6 +169,22 @@ impl World {
         Ok(())
     }
 
+    /// Lift object `id` and put it down `by` (dx, dy in metres, dθ in radians, table frame)
+    /// from where it is, as a hand would; whatever it then overlaps is pushed apart by the next
+    /// steps. `false` when there is no such object.
+    pub fn shift_object(&mut self, id: &str, by: [f64; 3]) -> bool {
+        let Some((_, s)) = self.objects.iter_mut().find(|(o, _)| o == id) else {
+            return false;
+        };
+        s.pose = Pose::new(
+            s.pose.x + by[0],
+            s.pose.y + by[1],
+            wrap_angle(s.pose.theta + by[2]),
+        );
+        self.last = (Vec::new(), None);
+        true
+    }
+
     /// Add a pushable object with the default support-friction load ([`DEFAULT_LOAD`]).
     /// Fails if it overlaps the robot, an obstacle, another object or leaves the table.
     pub fn add_object(&mut self, id: &str, slider: Slider) -> Result<()> {
