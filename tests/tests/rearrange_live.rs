@@ -97,10 +97,11 @@ fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
         t.sim().truth().t > 25.0,
         "the run ended before the hand came"
     );
-    let moved_b = report
-        .replans
-        .iter()
-        .find(|r| r.moved.iter().any(|(name, a, b)| name == "b" && a.1 != b.1));
+    let moved_b = report.replans.iter().find(|r| {
+        r.moved
+            .iter()
+            .any(|m| m.name == "b" && m.expected.1 != m.observed.1)
+    });
     assert!(
         moved_b.is_some(),
         "no re-plan saw box b off its row: {:?}",

@@ -79,13 +79,24 @@ pub struct ExecReport {
     pub final_movables: Vec<(i32, i32, u8)>,
 }
 
+/// A movable found off the cell the plan had put it in.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MovedBox {
+    /// Its name.
+    pub name: String,
+    /// The cell the plan had put it in (x, y).
+    pub expected: (i32, i32),
+    /// The cell it was seen in.
+    pub observed: (i32, i32),
+}
+
 /// A re-plan: the movables were not where the plan had put them.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Replan {
     /// Segments carried out before it.
     pub after_segment: usize,
-    /// Each movable found off its expected cell: name, expected cell, observed cell.
-    pub moved: Vec<(String, (i32, i32), (i32, i32))>,
+    /// Each movable found off its expected cell.
+    pub moved: Vec<MovedBox>,
     /// Cost of the rest of the plan as expected, and from where the movables were.
     pub cost_expected: u32,
     /// Cost from the observed configuration (an instant lookup in the cost map).
@@ -217,13 +228,17 @@ pub fn execute(
             );
         }
         let q = snap_free(model, &frame, io, q);
-        let moved: Vec<(String, (i32, i32), (i32, i32))> = match &expected {
+        let moved: Vec<MovedBox> = match &expected {
             Some(e) => p
                 .movables
                 .iter()
                 .zip(e.movables.iter().zip(&q.movables))
                 .filter(|(_, (a, b))| (a.x, a.y) != (b.x, b.y))
-                .map(|(m, (a, b))| (m.name.clone(), (a.x, a.y), (b.x, b.y)))
+                .map(|(m, (a, b))| MovedBox {
+                    name: m.name.clone(),
+                    expected: (a.x, a.y),
+                    observed: (b.x, b.y),
+                })
                 .collect(),
             None => Vec::new(),
         };
@@ -251,7 +266,10 @@ pub fn execute(
                 report.segments,
                 moved
                     .iter()
-                    .map(|(n, a, b)| format!("`{n}` at cell {b:?}, not {a:?}"))
+                    .map(|m| format!(
+                        "`{}` at cell {:?}, not {:?}",
+                        m.name, m.observed, m.expected
+                    ))
                     .collect::<Vec<_>>()
                     .join(", ")
             );
