@@ -385,3 +385,20 @@ fn intrinsics_files_that_do_not_make_a_lens() {
         assert_bad_input(&r, &[file, needle]);
     }
 }
+
+/// A disturbance that does not parse, or names no object of any stage, is refused before
+/// anything runs; so is one for `pushbot-sim`'s scene.
+#[test]
+fn disturbances_that_are_malformed_or_name_no_object() {
+    let r = pushbot(&["demo", "--stages", "rearrange", "--disturb", "25:b:0"]);
+    assert_bad_input(&r, &["--disturb", "AT:OBJECT:DX:DY"]);
+    let r = pushbot(&["demo", "--stages", "rearrange", "--disturb", "x:b:0:0.1"]);
+    assert_bad_input(&r, &["--disturb", "not a number"]);
+    let r = pushbot(&["demo", "--stages", "rearrange", "--disturb", "25:zz:0:0.1"]);
+    assert_bad_input(&r, &["--disturb", "\"zz\"", "a, b"]);
+    let r = run_bin(
+        "pushbot-sim",
+        &["--scene", "bsr-a1", "--no-stdin", "--disturb", "5:zz:0:0.1"],
+    );
+    assert_bad_input(&r, &["--disturb", "\"zz\""]);
+}
