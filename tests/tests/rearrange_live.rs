@@ -5,38 +5,35 @@
 
 use pushbot::exec::rearrange::{ExecOptions, execute};
 use pushbot::exec::{LiveOptions, LiveRobot};
+use pushbot::planner::rearrange::costmap::CostMap;
 use pushbot::planner::rearrange::frame::GridFrame;
 use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
-use pushbot::planner::rearrange::{Model, cases::load_scene, cost_map};
+use pushbot::planner::rearrange::{Model, Problem, cases::load_scene, cost_map};
 use pushbot::sim::SimTarget;
 use pushbot_tests::SIM_SPEED;
+use pushbot_world::Scene;
 
-#[test]
-fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
-    pushbot_tests::init_logging();
-    // About 20 s; a run that stops making progress fails instead of holding up the suite.
-    let _limit = pushbot_tests::WallLimit::arm(
-        "case_a1_is_executed_over_the_serial_port_with_camera_feedback",
-        std::time::Duration::from_secs(10 * 60),
-    );
+/// Case A1: the problem, its model and cost map, the grid's scene options and its scene.
+fn case_a1() -> (Problem, Model, CostMap, SceneOptions, Scene) {
     let p = load_scene("A1").expect("preset");
     let model = Model::new(&p).expect("model");
     let map = cost_map(&model).expect("map");
     let so = SceneOptions::default();
     let scene = scene_for(&p, &so).expect("scene");
-    let t =
-        SimTarget::start(&scene, 11, SIM_SPEED, None, None).expect("start the simulated target");
-    let opts = LiveOptions {
+    (p, model, map, so, scene)
+}
+
+/// The executor's robot for a target at [`SIM_SPEED`]: a one-second watchdog in wall time.
+fn live_options() -> LiveOptions {
+    LiveOptions {
         watchdog_ms: (1000.0 * SIM_SPEED) as u16,
         boundary_inset: 0.0,
         ..LiveOptions::default()
-    };
-    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, opts).expect("connect");
-    let report = execute(&model, &map, &mut robot, &ExecOptions::default()).expect("execute");
-    eprintln!("{report:?}");
-    assert!(report.reached, "{report:?}");
-    assert!(report.pushes > 0);
-    // Ground truth: every box inside its goal cell.
+    }
+}
+
+/// Ground truth: every box inside its goal cell.
+fn boxes_home(p: &Problem, so: &SceneOptions, t: &SimTarget) {
     let frame = GridFrame {
         cell: so.cell,
         h: p.grid.h,
@@ -60,6 +57,26 @@ fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
             want.y
         );
     }
+}
+
+#[test]
+fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
+    pushbot_tests::init_logging();
+    // About 20 s; a run that stops making progress fails instead of holding up the suite.
+    let _limit = pushbot_tests::WallLimit::arm(
+        "case_a1_is_executed_over_the_serial_port_with_camera_feedback",
+        std::time::Duration::from_secs(10 * 60),
+    );
+    let (p, model, map, so, scene) = case_a1();
+    let t =
+        SimTarget::start(&scene, 11, SIM_SPEED, None, None).expect("start the simulated target");
+    let mut robot =
+        LiveRobot::connect(t.port(), t.camera(), &scene, live_options()).expect("connect");
+    let report = execute(&model, &map, &mut robot, &ExecOptions::default()).expect("execute");
+    eprintln!("{report:?}");
+    assert!(report.reached, "{report:?}");
+    assert!(report.pushes > 0);
+    boxes_home(&p, &so, &t);
     drop(robot);
     t.shutdown().expect("sim ran cleanly");
 }
@@ -75,20 +92,12 @@ fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
         "a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is",
         std::time::Duration::from_secs(10 * 60),
     );
-    let p = load_scene("A1").expect("preset");
-    let model = Model::new(&p).expect("model");
-    let map = cost_map(&model).expect("map");
-    let so = SceneOptions::default();
-    let scene = scene_for(&p, &so).expect("scene");
+    let (p, model, map, so, scene) = case_a1();
     let disturb: Disturbance = "25:b:0:0.1".parse().expect("a disturbance");
     let t = SimTarget::start_with(&scene, 12, SIM_SPEED, None, None, vec![disturb])
         .expect("start the simulated target");
-    let opts = LiveOptions {
-        watchdog_ms: (1000.0 * SIM_SPEED) as u16,
-        boundary_inset: 0.0,
-        ..LiveOptions::default()
-    };
-    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, opts).expect("connect");
+    let mut robot =
+        LiveRobot::connect(t.port(), t.camera(), &scene, live_options()).expect("connect");
     assert!(t.sim().truth().t < 25.0, "connecting took 5 s of wall time");
     let report = execute(&model, &map, &mut robot, &ExecOptions::default()).expect("execute");
     eprintln!("{report:?}");
@@ -107,28 +116,7 @@ fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
         "no re-plan saw box b off its row: {:?}",
         report.replans
     );
-    let frame = GridFrame {
-        cell: so.cell,
-        h: p.grid.h,
-    };
-    let truth = t.sim().objects();
-    for (m, g) in p.movables.iter().zip(&p.goal_movables) {
-        let g = g.expect("A1 gives every box a goal");
-        let (_, pose) = truth
-            .iter()
-            .find(|(id, _)| *id == m.name)
-            .expect("box in the sim");
-        let want = frame.centre(g.x, g.y);
-        assert!(
-            (pose.x - want.x).abs().max((pose.y - want.y).abs()) < 0.5 * so.cell,
-            "box `{}` at ({:.3}, {:.3}), goal ({:.3}, {:.3})",
-            m.name,
-            pose.x,
-            pose.y,
-            want.x,
-            want.y
-        );
-    }
+    boxes_home(&p, &so, &t);
     drop(robot);
     t.shutdown().expect("sim ran cleanly");
 }

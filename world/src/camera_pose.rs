@@ -174,21 +174,7 @@ mod tests {
     use crate::lens::Distortion;
 
     fn webcam() -> Intrinsics {
-        Intrinsics {
-            width: 960,
-            height: 720,
-            fx: 700.0,
-            fy: 702.0,
-            cx: 480.5,
-            cy: 360.5,
-            distortion: Distortion {
-                k1: -0.08,
-                k2: 0.02,
-                p1: 0.001,
-                p2: -0.0005,
-                k3: -0.003,
-            },
-        }
+        crate::lens::test_webcam()
     }
 
     fn tilted() -> CameraPose {

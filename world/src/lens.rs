@@ -222,27 +222,33 @@ impl Intrinsics {
     }
 }
 
+/// A typical webcam (issue 20: k1 = −0.08, f = 700 px) with some of every coefficient, for
+/// this crate's tests.
+#[cfg(test)]
+pub(crate) fn test_webcam() -> Intrinsics {
+    Intrinsics {
+        width: 960,
+        height: 720,
+        fx: 700.0,
+        fy: 702.0,
+        cx: 480.5,
+        cy: 360.5,
+        distortion: Distortion {
+            k1: -0.08,
+            k2: 0.02,
+            p1: 0.001,
+            p2: -0.0005,
+            k3: -0.003,
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A typical webcam (issue 20: k1 = −0.08, f = 700 px) with some of every coefficient.
     fn webcam() -> Intrinsics {
-        Intrinsics {
-            width: 960,
-            height: 720,
-            fx: 700.0,
-            fy: 702.0,
-            cx: 480.5,
-            cy: 360.5,
-            distortion: Distortion {
-                k1: -0.08,
-                k2: 0.02,
-                p1: 0.001,
-                p2: -0.0005,
-                k3: -0.003,
-            },
-        }
+        test_webcam()
     }
 
     #[test]

@@ -102,10 +102,8 @@ impl BoardCamera {
         let (w, h) = (self.lens.width as usize, self.lens.height as usize);
         let hom = self.homography(board_to_camera);
         // The ideal image reaches past the frame where the lens sees past it.
-        let [ox, oy] = self.warp.ideal_origin();
         let [cw, ch] = self.warp.ideal_size();
-        let shift = Homography([[1.0, 0.0, -ox], [0.0, 1.0, -oy], [0.0, 0.0, 1.0]]);
-        let mut canvas = Canvas::new(cw, ch, shift.compose(&hom), im.floor_shade)
+        let mut canvas = Canvas::new(cw, ch, self.warp.onto_ideal_image(&hom), im.floor_shade)
             .ok_or_else(|| CameraError::Invalid("the board is seen edge-on".into()))?;
         let n = im.supersample.max(1);
         canvas.polygon(

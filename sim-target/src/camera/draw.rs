@@ -79,10 +79,7 @@ impl Camera {
     /// warp may move).
     fn to_canvas(&self, h: render::Homography) -> render::Homography {
         match &self.warp {
-            Some(w) => {
-                let [ox, oy] = w.ideal_origin();
-                render::Homography([[1.0, 0.0, -ox], [0.0, 1.0, -oy], [0.0, 0.0, 1.0]]).compose(&h)
-            }
+            Some(w) => w.onto_ideal_image(&h),
             None => h,
         }
     }

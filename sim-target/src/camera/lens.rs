@@ -5,6 +5,7 @@
 //! `initUndistortRectifyMap` + `remap` do the other way round. Marker corners in the ground
 //! truth go through the same distortion.
 
+use pushbot_world::camera::Homography;
 use pushbot_world::lens::Intrinsics;
 
 /// Where each output pixel samples the ideal image (its index-space x, y; NaN: nowhere). The
@@ -71,6 +72,13 @@ impl LensWarp {
     /// Where the ideal image's top-left corner is in the ideal pixel frame (≤ 0).
     pub fn ideal_origin(&self) -> [f64; 2] {
         self.origin
+    }
+
+    /// `h` (anything → ideal pixels) made to draw on the ideal image, whose top-left corner is
+    /// [`LensWarp::ideal_origin`].
+    pub fn onto_ideal_image(&self, h: &Homography) -> Homography {
+        let [ox, oy] = self.origin;
+        Homography([[1.0, 0.0, -ox], [0.0, 1.0, -oy], [0.0, 0.0, 1.0]]).compose(h)
     }
 
     /// The ideal image's size, pixels.
