@@ -5,8 +5,8 @@
 
 use pushbot::planner::rearrange::cases::{CASES, load_scene, problem_from_toml};
 use pushbot::planner::rearrange::{
-    Config, Dir, Model, MoveKind, Plan, Problem, RestoreError, cost_map, replay_cost, restore,
-    solve,
+    Config, Dir, Model, MoveKind, Plan, Problem, RestoreError, cost_map, cost_map_with,
+    replay_cost, restore, solve,
 };
 
 fn plan_of(name: &str) -> (Problem, Model, Plan) {
@@ -20,8 +20,8 @@ fn configs(plan: &Plan) -> Vec<Config> {
 }
 
 /// The movables pushed, stage by stage, with repeats of the same movable merged.
-fn push_runs(plan: &Plan) -> Vec<u8> {
-    let mut runs: Vec<u8> = Vec::new();
+fn push_runs(plan: &Plan) -> Vec<u64> {
+    let mut runs: Vec<u64> = Vec::new();
     for s in &plan.steps {
         if let MoveKind::Push { pushed } = s.step.kind
             && runs.last() != Some(&pushed)
@@ -240,7 +240,7 @@ fn the_map_is_reused_for_new_starts() {
     let model = Model::new(&p).unwrap();
     let map = cost_map(&model).unwrap();
     let mut solved = 0;
-    for idx in (0..model.n_states as u32).step_by(97) {
+    for idx in (0..model.n_states).step_by(97) {
         match restore(&model, &map, idx) {
             Ok(plan) => {
                 solved += 1;
@@ -254,6 +254,36 @@ fn the_map_is_reused_for_new_starts() {
         }
     }
     assert!(solved > 10);
+}
+
+/// Past 2³² configurations the map is built with `u64` indices; on the paper's cases (2 and 3
+/// movables, with and without robot memory, 3-DOF in D1) forcing them gives the same map.
+#[test]
+fn wide_indices_give_the_same_map() {
+    for (name, _, _) in CASES {
+        let (_, model, _) = plan_of(name);
+        assert!(!model.wide(), "{name}");
+        let goals = model.goal_states();
+        let narrow = cost_map_with::<u32>(&model, &goals).unwrap();
+        let wide = cost_map_with::<u64>(&model, &goals).unwrap();
+        assert_eq!(
+            narrow.stats.states_mapped, wide.stats.states_mapped,
+            "{name}"
+        );
+        assert!(narrow.stats.states_mapped > 100, "{name}");
+        assert!(narrow.cost == wide.cost, "{name}: the maps differ");
+        let mut o32 = Vec::new();
+        let mut o64 = Vec::new();
+        for idx in (0..model.n_states).step_by(31) {
+            if !model.valid(&model.decode(idx)) {
+                continue;
+            }
+            model.origins(idx as u32, &mut o32);
+            model.origins(idx, &mut o64);
+            let o32: Vec<(u64, u32)> = o32.iter().map(|&(q, c)| (q as u64, c)).collect();
+            assert_eq!(o32, o64, "{name}: origins of {idx}");
+        }
+    }
 }
 
 #[test]
@@ -279,7 +309,7 @@ fn brute_force_cost(model: &Model, start: &Config) -> Option<u32> {
     use std::collections::{BinaryHeap, HashMap};
     let p = &model.problem;
     let s = model.pack(start)?;
-    let mut dist: HashMap<u32, u32> = HashMap::from([(s, 0)]);
+    let mut dist: HashMap<u64, u32> = HashMap::from([(s, 0)]);
     let mut heap = BinaryHeap::from([Reverse((0u32, s))]);
     let mut nb = Vec::new();
     while let Some(Reverse((d, idx))) = heap.pop() {

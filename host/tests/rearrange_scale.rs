@@ -2,7 +2,7 @@
 //! the practical mode beyond it, through the library and through `pushbot plan rearrange`.
 
 use pushbot::experiments::rearrange_bench::{bench_problem, warehouse_problem};
-use pushbot::planner::rearrange::budget::{ExactBudget, TooLarge};
+use pushbot::planner::rearrange::budget::{ExactBudget, TooLarge, human};
 use pushbot::planner::rearrange::cases::load_scene;
 use pushbot::planner::rearrange::practical::{Action, Options, plan_practical};
 use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
@@ -36,15 +36,22 @@ fn the_memory_estimate_is_what_the_map_takes() {
 
 #[test]
 fn too_large_maps_are_refused_naming_the_memory_and_the_practical_mode() {
-    let four = ExactBudget::of(&bench_problem(10, 4));
+    // 10¹⁰ configurations: past a u32 index, so u64 indices; refused or not by memory alone.
+    let mut four = ExactBudget::of(&bench_problem(10, 4));
     assert_eq!(four.configurations, 10_000_000_000);
+    let need = four.bytes;
+    assert!(need > 20_000_000_000 && need < 30_000_000_000, "{need}");
+    four.available = Some(16 << 30);
     let e = four.check().unwrap_err();
-    assert!(matches!(e, TooLarge::Index { .. }), "{e}");
+    assert!(matches!(e, TooLarge::Memory { .. }), "{e}");
     let msg = e.to_string();
     assert!(
-        msg.contains("37.3 GiB") && msg.contains("--mode practical"),
+        msg.contains(&human(need)) && msg.contains("16.0 GiB") && msg.contains("--mode practical"),
         "{msg}"
     );
+    four.available = Some(64 << 30);
+    assert_eq!(four.check(), Ok(()));
+    assert!(Model::new(&bench_problem(10, 4)).unwrap().wide());
     let twelve = ExactBudget::of(&warehouse_problem(12));
     let msg = twelve.check().unwrap_err().to_string();
     assert!(

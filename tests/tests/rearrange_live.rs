@@ -3,10 +3,11 @@
 //! observes the boxes through the real vision pipeline on the sim's camera
 //! ([`pushbot::exec::LiveRobot`]); the simulator's ground truth judges where the boxes ended.
 
-use pushbot::exec::rearrange::{ExecOptions, execute};
+use pushbot::exec::rearrange::{ExecOptions, ExecReport, execute, execute_practical};
 use pushbot::exec::{LiveOptions, LiveRobot};
 use pushbot::planner::rearrange::costmap::CostMap;
 use pushbot::planner::rearrange::frame::GridFrame;
+use pushbot::planner::rearrange::practical::Options;
 use pushbot::planner::rearrange::to_scene::{SceneOptions, scene_for};
 use pushbot::planner::rearrange::{Model, Problem, cases::load_scene, cost_map};
 use pushbot::sim::SimTarget;
@@ -82,24 +83,24 @@ fn case_a1_is_executed_over_the_serial_port_with_camera_feedback() {
 }
 
 /// A box moved by hand mid-run (the simulator's disturbance: box `b` put down 10 cm off its
-/// row): the executor sees it off the cell the plan had put it in, re-plans from where it is (a
-/// lookup in the same cost map), says so in its report, and still brings both boxes home.
-#[test]
-fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
+/// row): the executor sees it off the cell the plan had put it in, re-plans from where it is,
+/// says so in its report, and still brings both boxes home. Returns the report.
+fn disturbed_a1(
+    test: &str,
+    seed: u64,
+    run: impl FnOnce(&Problem, &Model, &CostMap, &mut LiveRobot) -> ExecReport,
+) -> ExecReport {
     use pushbot::sim::target::Disturbance;
     pushbot_tests::init_logging();
-    let _limit = pushbot_tests::WallLimit::arm(
-        "a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is",
-        std::time::Duration::from_secs(10 * 60),
-    );
+    let _limit = pushbot_tests::WallLimit::arm(test, std::time::Duration::from_secs(10 * 60));
     let (p, model, map, so, scene) = case_a1();
     let disturb: Disturbance = "25:b:0:0.1".parse().expect("a disturbance");
-    let t = SimTarget::start_with(&scene, 12, SIM_SPEED, None, None, vec![disturb])
+    let t = SimTarget::start_with(&scene, seed, SIM_SPEED, None, None, vec![disturb])
         .expect("start the simulated target");
     let mut robot =
         LiveRobot::connect(t.port(), t.camera(), &scene, live_options()).expect("connect");
     assert!(t.sim().truth().t < 25.0, "connecting took 5 s of wall time");
-    let report = execute(&model, &map, &mut robot, &ExecOptions::default()).expect("execute");
+    let report = run(&p, &model, &map, &mut robot);
     eprintln!("{report:?}");
     assert!(report.reached, "{report:?}");
     assert!(
@@ -119,4 +120,35 @@ fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
     boxes_home(&p, &so, &t);
     drop(robot);
     t.shutdown().expect("sim ran cleanly");
+    report
+}
+
+/// The exact mode re-plans by a lookup in the same cost map.
+#[test]
+fn a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is() {
+    let report = disturbed_a1(
+        "a_box_moved_by_hand_mid_run_is_replanned_from_where_it_is",
+        12,
+        |_, model, map, robot| {
+            execute(model, map, robot, &ExecOptions::default()).expect("execute")
+        },
+    );
+    assert_eq!(report.mode, "exact");
+}
+
+/// The practical mode (no cost map) follows its plan while the camera agrees, and plans again
+/// from the observation when box `b` is not where the plan had put it.
+#[test]
+fn the_practical_mode_replans_a_box_moved_by_hand() {
+    let report = disturbed_a1(
+        "the_practical_mode_replans_a_box_moved_by_hand",
+        12,
+        |p, _, _, robot| {
+            let opts = Options::for_problem(p);
+            execute_practical(p, opts, robot, &ExecOptions::default()).expect("execute")
+        },
+    );
+    assert_eq!(report.mode, "practical");
+    // Plans made: the first, and one per observation that was not where the plan had put things.
+    assert!(report.plans >= 2, "{report:?}");
 }

@@ -56,7 +56,7 @@ pub struct BenchArgs {
 }
 
 fn step_json(model: &Model, st: &rearrange::restore::PlanStep) -> serde_json::Value {
-    let names = |mask: u8| -> Vec<String> {
+    let names = |mask: u64| -> Vec<String> {
         (0..model.r())
             .filter(|i| mask & (1 << i) != 0)
             .map(|i| model.problem.movables[i].name.clone())

@@ -22,6 +22,7 @@ pub mod io;
 pub mod live;
 pub mod maneuver;
 pub mod odometry_feed;
+pub mod plan_source;
 pub mod primitive;
 pub mod rearrange;
 pub mod record;

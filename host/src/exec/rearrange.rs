@@ -7,20 +7,25 @@
 //! carry out its first *segment*, the longest run of moves in one direction of one kind (a
 //! transit drive, or a push run that ends by backing off the movable to the cell centre). The
 //! map is never recomputed: when a movable ends off its expected cell, the snapped configuration
-//! is simply a new start for restoration, which costs no re-propagation.
+//! is simply a new start for restoration, which costs no re-propagation. With many movables
+//! ([`execute_practical`]) the moves come from the practical mode's plan instead, planned again
+//! from the observation when it leaves the plan ([`crate::exec::plan_source`]).
 
 use std::f64::consts::FRAC_PI_2;
 
-use anyhow::{Context, Result, anyhow, bail};
+use std::collections::HashMap;
+
+use anyhow::{Result, anyhow, bail};
 use nalgebra::Vector2;
 
 use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{self, Drive, Turn};
+use crate::exec::plan_source::{ExactSource, PlanSource, PracticalSource};
 use crate::planner::rearrange::admissibility::MoveKind;
 use crate::planner::rearrange::costmap::CostMap;
 use crate::planner::rearrange::frame::GridFrame;
-use crate::planner::rearrange::problem::{Config, Dir, Model, Placement};
-use crate::planner::rearrange::restore::restore;
+use crate::planner::rearrange::practical::Options;
+use crate::planner::rearrange::problem::{Config, Dir, Model, Placement, Problem};
 
 /// Settings of the executor.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,6 +60,11 @@ impl Default for ExecOptions {
 pub struct ExecReport {
     /// The goal set was reached (the observed configuration has cost 0).
     pub reached: bool,
+    /// The planner: "exact" (the cost map) or "practical".
+    pub mode: String,
+    /// Plans made: always 1 with the exact map (re-plans are lookups in it); with the practical
+    /// mode, the first plan and one for each observation that left it.
+    pub plans: usize,
     /// Segments carried out (transit drives and push runs).
     pub segments: usize,
     /// Grid moves carried out.
@@ -106,12 +116,11 @@ pub struct Replan {
 /// Observe the robot and every movable and snap them to the grid. `memory` is the robot's last
 /// move (direction, was a push), which the camera cannot see.
 pub fn observe(
-    model: &Model,
+    p: &Problem,
     frame: &GridFrame,
     io: &mut dyn RobotIo,
     memory: (Dir, bool),
 ) -> Result<Config> {
-    let p = &model.problem;
     let k = p.robot.size;
     let rp = io.robot_pose();
     let half = (k - 1) as f64 / 2.0 * frame.cell;
@@ -139,11 +148,11 @@ pub fn observe(
 
 /// When the snapped configuration overlaps (the robot was seen across a cell border from
 /// where it stands clear), put the robot on the nearest cell around it that is free.
-fn snap_free(model: &Model, frame: &GridFrame, io: &mut dyn RobotIo, q: Config) -> Config {
-    if model.pack(&q).is_some() {
+fn snap_free(src: &dyn PlanSource, frame: &GridFrame, io: &mut dyn RobotIo, q: Config) -> Config {
+    if src.free(&q) {
         return q;
     }
-    let k = model.problem.robot.size;
+    let k = src.problem().robot.size;
     let rp = io.robot_pose().position();
     let mut options: Vec<(f64, (i32, i32))> = Vec::new();
     for dy in -1..=1 {
@@ -158,7 +167,7 @@ fn snap_free(model: &Model, frame: &GridFrame, io: &mut dyn RobotIo, q: Config) 
             robot: a,
             ..q.clone()
         };
-        if model.pack(&c).is_some() {
+        if src.free(&c) {
             return c;
         }
     }
@@ -184,7 +193,28 @@ pub fn execute(
     io: &mut dyn RobotIo,
     opts: &ExecOptions,
 ) -> Result<ExecReport> {
-    let p = &model.problem;
+    execute_from(&mut ExactSource { model, map }, io, opts)
+}
+
+/// Carry out a practical-mode plan (many movables) until the goal set is reached, re-observing
+/// after every segment and planning again from the observation when it is not where the plan
+/// had put things.
+pub fn execute_practical(
+    problem: &Problem,
+    plan_opts: Options,
+    io: &mut dyn RobotIo,
+    opts: &ExecOptions,
+) -> Result<ExecReport> {
+    execute_from(&mut PracticalSource::new(problem, plan_opts), io, opts)
+}
+
+/// Carry out the plans of `src` until the goal set is reached, re-observing after every segment.
+pub fn execute_from(
+    src: &mut dyn PlanSource,
+    io: &mut dyn RobotIo,
+    opts: &ExecOptions,
+) -> Result<ExecReport> {
+    let p = &src.problem().clone();
     let frame = GridFrame {
         cell: opts.cell,
         h: p.grid.h,
@@ -197,9 +227,12 @@ pub fn execute(
     let t0 = io.time();
     let mut memory = (p.start.heading, p.start.pushing);
     let mut expected: Option<Config> = None;
-    let mut seen: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    let mut seen: HashMap<((i32, i32), Vec<Placement>), usize> = HashMap::new();
+    let mut expected_cost = 0u32;
     let mut report = ExecReport {
         reached: false,
+        mode: src.mode().to_string(),
+        plans: 1,
         segments: 0,
         moves: 0,
         pushes: 0,
@@ -212,7 +245,7 @@ pub fn execute(
         final_movables: Vec::new(),
     };
     loop {
-        let q = observe(model, &frame, io, memory)?;
+        let q = observe(p, &frame, io, memory)?;
         report.final_robot = q.robot;
         report.final_movables = q.movables.iter().map(|m| (m.x, m.y, m.o)).collect();
         if let Some(e) = &expected
@@ -227,7 +260,7 @@ pub fn execute(
                 e.movables
             );
         }
-        let q = snap_free(model, &frame, io, q);
+        let q = snap_free(&*src, &frame, io, q);
         let moved: Vec<MovedBox> = match &expected {
             Some(e) => p
                 .movables
@@ -242,27 +275,16 @@ pub fn execute(
                 .collect(),
             None => Vec::new(),
         };
-        let idx = model.pack(&q).ok_or_else(|| {
-            anyhow!(
-                "the observed configuration (robot {:?}, movables {:?}) is not free on the grid",
-                q.robot,
-                q.movables
-            )
-        })?;
-        let cost = map
-            .get(idx)
-            .ok_or_else(|| anyhow!("no pushing path exists from the observed configuration"))?;
+        let rest = src.rest_from(&q)?;
+        let cost = rest.cost;
         if report.segments == 0 {
             report.planned_cost = cost;
         }
         if !moved.is_empty() {
-            let cost_expected = expected
-                .as_ref()
-                .and_then(|e| model.pack(e))
-                .and_then(|i| map.get(i))
-                .unwrap_or(cost);
+            let cost_expected = expected_cost;
             tracing::info!(
-                "re-plan after segment {}: {}; cost {cost_expected} → {cost}",
+                "re-plan ({}) after segment {}: {}; cost {cost_expected} → {cost}",
+                src.mode(),
                 report.segments,
                 moved
                     .iter()
@@ -284,7 +306,7 @@ pub fn execute(
             report.reached = true;
             break;
         }
-        let repeats = seen.entry(idx).or_insert(0);
+        let repeats = seen.entry((q.robot, q.movables.clone())).or_insert(0);
         *repeats += 1;
         if *repeats > opts.max_repeats {
             let n = *repeats;
@@ -309,16 +331,21 @@ pub fn execute(
         if report.segments >= opts.max_segments {
             break;
         }
-        let plan = restore(model, map, idx).context("restoring the plan")?;
-        let first = &plan.steps[0].step;
-        let same = |s: &crate::planner::rearrange::admissibility::Step| {
-            s.dir == first.dir && s.kind == first.kind
+        let Some(first) = rest.moves.first() else {
+            bail!(
+                "the {} planner gave no move from a configuration of cost {cost}",
+                src.mode()
+            );
         };
-        let mut n = plan.steps.iter().take_while(|s| same(&s.step)).count();
+        let mut n = rest
+            .moves
+            .iter()
+            .take_while(|s| s.dir == first.dir && s.kind == first.kind)
+            .count();
         if let MoveKind::Push { .. } = first.kind {
             n = n.min(opts.max_push_cells.max(1));
         }
-        let seg = &plan.steps[..n];
+        let seg = &rest.moves[..n];
         let last = &seg[n - 1].config;
         let end = frame.robot_centre(last.robot, k);
         tracing::debug!(
@@ -385,10 +412,14 @@ pub fn execute(
         }
         report.segments += 1;
         report.moves += n;
-        report.executed_cost += seg.iter().map(|s| s.step.cost).sum::<u32>();
+        let seg_cost = seg.iter().map(|s| s.cost).sum::<u32>();
+        report.executed_cost += seg_cost;
+        expected_cost = cost - seg_cost;
         memory = (first.dir, !matches!(first.kind, MoveKind::Transit));
         expected = Some(last.clone());
+        src.advance(n);
     }
     report.time_s = io.time() - t0;
+    report.plans = src.plans();
     Ok(report)
 }

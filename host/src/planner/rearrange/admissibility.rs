@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::metric::StepKind;
-use super::problem::{Dir, MAX_MOVABLES, Model, NONE, RotInstance, State};
+use super::problem::{Dir, MAX_MOVABLES, Model, NONE, PackedIndex, RotInstance, State};
 
 /// What a move does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -32,8 +32,8 @@ pub enum MoveKind {
     Transit,
     /// The robot translates the movables in this bit mask.
     Push {
-        /// Bit i: movable i moved.
-        pushed: u8,
+        /// Bit i: movable i moved (the practical mode's plans number up to 64 movables).
+        pushed: u64,
     },
     /// The robot turns one movable by a quarter turn.
     Rotate {
@@ -44,11 +44,11 @@ pub enum MoveKind {
     },
 }
 
-/// One admissible move from a configuration.
+/// One admissible move from a configuration (its packed index an `I`, `u64` unless said).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Step {
+pub struct Step<I = u64> {
     /// The configuration it leads to.
-    pub to: u32,
+    pub to: I,
     /// Its cost D(Q, to).
     pub cost: u32,
     /// The robot's direction of motion.
@@ -174,7 +174,13 @@ impl Model {
             r: r2,
             m: m2,
         };
-        Some((t, cost, MoveKind::Push { pushed: mask as u8 }))
+        Some((
+            t,
+            cost,
+            MoveKind::Push {
+                pushed: mask as u64,
+            },
+        ))
     }
 
     /// The robot turns movable `i` with a rotational push, if admissible.
@@ -238,7 +244,7 @@ impl Model {
     }
 
     /// The admissible neighbours N_A(Q) of a packed configuration, with their costs.
-    pub fn neighbours(&self, idx: u32, out: &mut Vec<Step>) {
+    pub fn neighbours<I: PackedIndex>(&self, idx: I, out: &mut Vec<Step<I>>) {
         out.clear();
         let s = self.decode(idx);
         if !self.valid(&s) {
@@ -279,7 +285,7 @@ impl Model {
 
     /// The admissible origins N_A⁻¹(Q) ∩ CCF of a packed configuration, each with D(Q̂, Q).
     /// `idx` must be in CCF.
-    pub fn origins(&self, idx: u32, out: &mut Vec<(u32, u32)>) {
+    pub fn origins<I: PackedIndex>(&self, idx: I, out: &mut Vec<(I, u32)>) {
         out.clear();
         let q = self.decode(idx);
         let n = self.r();
@@ -297,8 +303,8 @@ impl Model {
         };
         let transit_arrival = transit_ok && self.arrival_ok(q.r, &q.m, 0);
         // Origins differ from Q in a few digits: build their indices by strides, not by encoding.
-        let base = idx - q.aux;
-        let sr = self.stride[1];
+        let base = idx.with_digit(1, q.aux, 0);
+        let sr = self.stride[1] as u32; // the robot memory's radix: 1 or 8
         let touching = (0..n)
             .any(|i| self.touch[i].get(q.m[i] as usize * self.radix[1] as usize + q.r as usize));
         for &d in dirs {
@@ -308,13 +314,13 @@ impl Model {
             }
             if transit_arrival && (0..n).all(|i| !self.rm_overlap(i, rh, q.m[i])) {
                 let c0 = self.robot_cost[q.r as usize];
-                let b = base.wrapping_add(rh.wrapping_sub(q.r).wrapping_mul(sr));
+                let b = base.with_digit(sr, q.r, rh);
                 if self.n_aux == 1 {
                     out.push((b, c0));
                 } else {
                     for a in 0..self.n_aux {
                         let c = c0 + metric.memory_cost(self.prev_memory(a), d, StepKind::Transit);
-                        out.push((b + a, c));
+                        out.push((b.plus(a), c));
                     }
                 }
             }

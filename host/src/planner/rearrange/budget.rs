@@ -10,7 +10,8 @@ use super::problem::{MAX_MOVABLES, Model, Problem};
 /// What the exact cost map of a problem would take.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ExactBudget {
-    /// Packed configurations (saturates at `u64::MAX`).
+    /// Packed configurations (saturates at `u64::MAX`). Indices are `u32` below 2³², `u64`
+    /// above: any map that fits in memory can be built.
     pub configurations: u64,
     /// The same as a float (does not saturate).
     pub configurations_f64: f64,
@@ -33,9 +34,9 @@ pub enum TooLarge {
         /// How many.
         movables: usize,
     },
-    /// More configurations than a `u32` index numbers.
+    /// More configurations than this machine can number (a 64-bit index, its address space).
     #[error(
-        "{configurations} configurations: the exact cost map would need {need} and its indices hold at most 2³² − 1 configurations; use --mode practical"
+        "{configurations} configurations or more: more than this machine can number, the exact cost map would need {need}; use --mode practical"
     )]
     Index {
         /// How many.
@@ -79,7 +80,7 @@ impl ExactBudget {
                 movables: self.movables,
             });
         }
-        if self.configurations >= u32::MAX as u64 {
+        if self.configurations == u64::MAX || usize::try_from(self.configurations).is_err() {
             return Err(TooLarge::Index {
                 configurations: self.configurations,
                 need: human(self.bytes),

@@ -19,7 +19,7 @@
 use std::sync::atomic::{AtomicU16, Ordering::Relaxed};
 use std::time::Instant;
 
-use super::problem::Model;
+use super::problem::{Model, PackedIndex};
 use super::wavefront::{BitRing, Front, Tally, VecRing};
 
 /// Cost of a configuration the wave never reached (no pushing path, CCO, trap points).
@@ -65,7 +65,7 @@ pub enum MapError {
 
 impl CostMap {
     /// Cost of a configuration, `None` when infinite.
-    pub fn get(&self, idx: u32) -> Option<u32> {
+    pub fn get(&self, idx: u64) -> Option<u32> {
         match self.cost.get(idx as usize) {
             Some(&c) if c != INF => Some(c as u32),
             _ => None,
@@ -77,6 +77,30 @@ impl CostMap {
 pub fn cost_map(model: &Model) -> Result<CostMap, MapError> {
     let goals = model.goal_states();
     cost_map_from(model, &goals)
+}
+
+/// Build the cost map with packed indices of type `I` throughout ([`cost_map_from`] picks the
+/// narrowest that numbers the space; a wider one gives the same map with more memory).
+///
+/// # Panics
+/// If `I` cannot number the model's space.
+pub fn cost_map_with<I: PackedIndex>(model: &Model, goals: &[u64]) -> Result<CostMap, MapError> {
+    assert!(
+        model.n_states <= I::from_u64(u64::MAX).as_u64(),
+        "{} configurations do not fit this index type",
+        model.n_states
+    );
+    let t0 = Instant::now();
+    let n = model.n_states as usize;
+    let ring = model.max_edge as usize + 1;
+    let goals: Vec<I> = goals.iter().map(|&g| I::from_u64(g)).collect();
+    let mut map = if uses_bitset(ring, n) {
+        propagate(model, &goals, BitRing::new(ring, n))?
+    } else {
+        propagate(model, &goals, VecRing::<I>::new(ring))?
+    };
+    map.stats.map_ms = t0.elapsed().as_secs_f64() * 1e3;
+    Ok(map)
 }
 
 /// The bit-set ring may take this many times the bytes of the cost array.
@@ -108,17 +132,13 @@ pub fn map_bytes_estimate(n_states: u64, max_edge: u32) -> u64 {
 ///
 /// When the ring of bit sets fits in [`BITSET_BUDGET`] times the cost array, the wave front is
 /// a ring of bit sets; otherwise (very expensive moves, so many buckets) a ring of vectors.
-pub fn cost_map_from(model: &Model, goals: &[u32]) -> Result<CostMap, MapError> {
-    let t0 = Instant::now();
-    let n = model.n_states as usize;
-    let ring = model.max_edge as usize + 1;
-    let mut map = if uses_bitset(ring, n) {
-        propagate(model, goals, BitRing::new(ring, n))?
+/// Indices are `u32` while the space has fewer than 2³² configurations, `u64` past it.
+pub fn cost_map_from(model: &Model, goals: &[u64]) -> Result<CostMap, MapError> {
+    if model.wide() {
+        cost_map_with::<u64>(model, goals)
     } else {
-        propagate(model, goals, VecRing::new(ring))?
-    };
-    map.stats.map_ms = t0.elapsed().as_secs_f64() * 1e3;
-    Ok(map)
+        cost_map_with::<u32>(model, goals)
+    }
 }
 
 /// The cost array and the cost being settled, shared by the cores during one sweep.
@@ -131,16 +151,16 @@ struct Wave<'a> {
 impl Wave<'_> {
     /// Settle `q` if it still holds cost `c`, relaxing its admissible origins.
     #[inline]
-    fn settle<F: Front>(
+    fn settle<I: PackedIndex, F: Front<I>>(
         &self,
-        q: u32,
+        q: I,
         front: &F,
         local: &mut F::Local,
         t: &mut Tally,
-        origins: &mut Vec<(u32, u32)>,
+        origins: &mut Vec<(I, u32)>,
     ) {
         let (model, cost, c) = (self.model, self.cost, self.c);
-        if cost[q as usize].load(Relaxed) as u32 != c {
+        if cost[q.as_usize()].load(Relaxed) as u32 != c {
             return; // stale: settled earlier with a lower cost
         }
         let ring = model.max_edge as usize + 1;
@@ -149,7 +169,7 @@ impl Wave<'_> {
         t.relaxations += origins.len() as u64;
         for &(p, d) in origins.iter() {
             let nc = c + d;
-            let slot = &cost[p as usize];
+            let slot = &cost[p.as_usize()];
             if nc >= INF as u32 {
                 t.overflow |= slot.load(Relaxed) == INF;
                 continue;
@@ -164,7 +184,11 @@ impl Wave<'_> {
 
 /// Dijkstra's order over the buckets: a state is settled when it is swept with the cost it
 /// holds; stale entries (improved since) are skipped. Each bucket is swept on every core.
-fn propagate<F: Front>(model: &Model, goals: &[u32], mut front: F) -> Result<CostMap, MapError> {
+fn propagate<I: PackedIndex, F: Front<I>>(
+    model: &Model,
+    goals: &[I],
+    mut front: F,
+) -> Result<CostMap, MapError> {
     let n = model.n_states as usize;
     let ring = model.max_edge as usize + 1;
     // Built from a `u16` vector, and turned back into one in place at the end (same layout).
@@ -174,8 +198,8 @@ fn propagate<F: Front>(model: &Model, goals: &[u32], mut front: F) -> Result<Cos
     let mut local = F::Local::default();
     let mut t = Tally::default();
     for &g in goals {
-        if cost[g as usize].load(Relaxed) != 0 {
-            cost[g as usize].store(0, Relaxed);
+        if cost[g.as_usize()].load(Relaxed) != 0 {
+            cost[g.as_usize()].store(0, Relaxed);
             front.push(&mut local, &mut t, 0, g);
             goal_count += 1;
         }

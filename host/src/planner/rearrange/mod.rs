@@ -22,13 +22,14 @@
 //! Limits (§IV-E): the map holds one `u16` per packed configuration, so memory grows as
 //! (free cells)^(1 + r) — 128 MB for the robot and 2 boxes in a 20 × 20 room, 860 MB for 3 boxes in
 //! 12 × 12, and a 4th box or a 3-DOF movable multiplies it again by the cells (and by 4); the
-//! wave front adds one bit per configuration per bucket (`max_edge + 1` buckets, 24 MB for the
-//! 2-box room). Time is bounded by cache misses on the cost array: the wave front is scattered,
+//! wave front adds at most one bit per configuration per bucket (`max_edge + 1` buckets), in
+//! 4 KiB pages taken when first written and given back when their bucket is swept (16 MB at
+//! its peak for the 2-box room). Time is bounded by cache misses on the cost array: the wave front is scattered,
 //! so each bucket is swept in index order (a bit set) and the map is visited in one forward pass
 //! per cost, the configurations of one cost split among the cores. Plan costs must stay below
-//! 65 535. Packed indices are `u32`: at most 2³² − 1 configurations (8 GiB of map); [`budget`]
-//! sizes a map before it is built and refuses one that would not fit, and the [`practical`]
-//! mode takes what the exact map cannot.
+//! 65 535. Packed indices are `u32` below 2³² configurations and `u64` from there on, so any map
+//! that fits in memory can be built; [`budget`] sizes a map before it is built and refuses one
+//! that would not fit, and the [`practical`] mode takes what the exact map cannot.
 
 pub mod admissibility;
 pub mod budget;
@@ -47,7 +48,9 @@ pub mod svg;
 pub mod to_scene;
 
 pub use admissibility::{MoveKind, Step};
-pub use costmap::{CostMap, INF, MapError, MapStats, cost_map, map_bytes_estimate};
+pub use costmap::{
+    CostMap, INF, MapError, MapStats, cost_map, cost_map_from, cost_map_with, map_bytes_estimate,
+};
 pub use metric::Metric;
 pub use problem::{
     Config, ContactMode, Dir, Grid, Model, MovableSpec, Placement, Problem, RobotSpec, Rules,

@@ -57,10 +57,9 @@ pub enum RestoreError {
 }
 
 /// Restore an optimal pushing path from `start` (packed) using the map.
-pub fn restore(model: &Model, map: &CostMap, start: u32) -> Result<Plan, RestoreError> {
+pub fn restore(model: &Model, map: &CostMap, start: u64) -> Result<Plan, RestoreError> {
     let t0 = Instant::now();
-    let s = model.decode(start);
-    if (start as u64) >= model.n_states || !model.valid(&s) {
+    if start >= model.n_states || !model.valid(&model.decode(start)) {
         return Err(RestoreError::StartNotFree);
     }
     let total = map.get(start).ok_or(RestoreError::NoPushingPath)?;

@@ -13,10 +13,12 @@
 //!   locally and they are appended after the sweep (for metrics with expensive moves, where a
 //!   bit set per bucket would outweigh the cost array).
 
-use std::sync::OnceLock;
-use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering::Relaxed};
+use std::sync::{Mutex, OnceLock};
 
 use rayon::prelude::*;
+
+use super::problem::PackedIndex;
 
 /// Buckets larger than this are sorted by index before they are swept.
 const SORT_MIN: usize = 4096;
@@ -49,36 +51,44 @@ impl Tally {
     }
 }
 
-/// A ring of buckets swept on every core.
-pub(super) trait Front: Sync + Sized {
+/// A ring of buckets of packed indices `I`, swept on every core.
+pub(super) trait Front<I: PackedIndex>: Sync + Sized {
     /// What one task gathers besides its tally (pushes not yet in the ring).
     type Local: Default + Send;
     /// Queue `idx` in bucket `b` (never the bucket being swept).
-    fn push(&self, local: &mut Self::Local, tally: &mut Tally, b: usize, idx: u32);
+    fn push(&self, local: &mut Self::Local, tally: &mut Tally, b: usize, idx: I);
     /// Put what a task gathered into the ring.
     fn absorb(&mut self, local: Self::Local);
     /// Sweep bucket `b` on every core, calling `f` on each of its indices, and empty it.
     fn sweep<G>(&mut self, b: usize, f: G) -> Tally
     where
-        G: Fn(u32, &Self, &mut Self::Local, &mut Tally, &mut Vec<(u32, u32)>) + Sync;
+        G: Fn(I, &Self, &mut Self::Local, &mut Tally, &mut Vec<(I, u32)>) + Sync;
     /// Most bytes the ring held.
     fn peak_bytes(&self) -> u64;
 }
 
-/// Words of one page of a bit-set bucket (4 KiB): pages are allocated when first written, so
-/// the parts of the space the wave front never reaches take no memory.
+/// Words of one page of a bit-set bucket (4 KiB): pages are taken when first written and given
+/// back when their bucket is swept, so the parts of the space the wave front never reaches take
+/// no memory, and the ring holds only the pages of the costs still queued.
 const PAGE_WORDS: usize = 512;
 
 /// One bit-set bucket: `pages` hold one bit per index, `summary` one bit per non-zero word.
 #[derive(Default)]
 struct BitBucket {
-    pages: Vec<OnceLock<Box<[AtomicU64]>>>,
+    pages: Vec<OnceLock<Page>>,
     summary: Vec<AtomicU64>,
 }
 
-/// Buckets as two-level bit sets over the whole space.
+/// A page of a bit-set bucket.
+type Page = Box<[AtomicU64]>;
+
+/// Buckets as two-level bit sets over the whole space, with the pages they share.
 pub(super) struct BitRing {
     buckets: Vec<BitBucket>,
+    /// Swept pages (all words zero again), reused before new ones are allocated.
+    spare: Mutex<Vec<Page>>,
+    /// Pages allocated so far: the ring's memory never exceeds them.
+    allocated: AtomicUsize,
 }
 
 impl BitRing {
@@ -94,7 +104,18 @@ impl BitRing {
                     summary: (0..nw.div_ceil(64)).map(|_| AtomicU64::new(0)).collect(),
                 })
                 .collect(),
+            spare: Mutex::new(Vec::new()),
+            allocated: AtomicUsize::new(0),
         }
+    }
+
+    /// A zero page: a swept one if any, else a new one.
+    fn take_page(&self) -> Page {
+        let reused = self.spare.lock().map(|mut s| s.pop()).unwrap_or(None);
+        reused.unwrap_or_else(|| {
+            self.allocated.fetch_add(1, Relaxed);
+            (0..PAGE_WORDS).map(|_| AtomicU64::new(0)).collect()
+        })
     }
 
     /// Most bytes of `ring` buckets over `n` indices (every page written).
@@ -104,19 +125,15 @@ impl BitRing {
     }
 }
 
-/// A page of zero words.
-fn new_page() -> Box<[AtomicU64]> {
-    (0..PAGE_WORDS).map(|_| AtomicU64::new(0)).collect()
-}
-
-impl Front for BitRing {
+impl<I: PackedIndex> Front<I> for BitRing {
     type Local = ();
     #[inline]
-    fn push(&self, _: &mut (), tally: &mut Tally, b: usize, idx: u32) {
+    fn push(&self, _: &mut (), tally: &mut Tally, b: usize, idx: I) {
         let bucket = &self.buckets[b];
-        let w = idx as usize >> 6;
+        let idx = idx.as_usize();
+        let w = idx >> 6;
         let bit = 1u64 << (idx & 63);
-        let word = &bucket.pages[w / PAGE_WORDS].get_or_init(new_page)[w % PAGE_WORDS];
+        let word = &bucket.pages[w / PAGE_WORDS].get_or_init(|| self.take_page())[w % PAGE_WORDS];
         if word.load(Relaxed) & bit != 0 {
             return;
         }
@@ -131,11 +148,11 @@ impl Front for BitRing {
     fn absorb(&mut self, _: ()) {}
     fn sweep<G>(&mut self, b: usize, f: G) -> Tally
     where
-        G: Fn(u32, &Self, &mut (), &mut Tally, &mut Vec<(u32, u32)>) + Sync,
+        G: Fn(I, &Self, &mut (), &mut Tally, &mut Vec<(I, u32)>) + Sync,
     {
         let mut bucket = std::mem::take(&mut self.buckets[b]);
         let this = &*self;
-        let tally = bucket
+        let (tally, swept) = bucket
             .summary
             .par_chunks_mut(PAGE_WORDS / 64)
             .zip(bucket.pages.par_iter_mut())
@@ -145,8 +162,8 @@ impl Front for BitRing {
             .with_max_len(1)
             .map(|(k, (summary, page))| {
                 let mut t = Tally::default();
-                let Some(words) = page.get_mut() else {
-                    return t;
+                let Some(mut words) = page.take() else {
+                    return (t, None);
                 };
                 let base = k * PAGE_WORDS * 64;
                 let mut local = ();
@@ -158,42 +175,55 @@ impl Front for BitRing {
                         sbits &= sbits - 1;
                         let mut bits = std::mem::take(words[wl].get_mut());
                         while bits != 0 {
-                            let idx = (base + wl * 64) as u32 + bits.trailing_zeros();
+                            let idx =
+                                I::from_u64((base + wl * 64) as u64 + bits.trailing_zeros() as u64);
                             bits &= bits - 1;
                             t.swept += 1;
                             f(idx, this, &mut local, &mut t, &mut origins);
                         }
                     }
                 }
-                t
+                (t, Some(words))
             })
-            .reduce(Tally::default, Tally::add);
+            .fold(
+                || (Tally::default(), Vec::new()),
+                |(t, mut pages), (u, page)| {
+                    pages.extend(page);
+                    (t.add(u), pages)
+                },
+            )
+            .reduce(
+                || (Tally::default(), Vec::new()),
+                |(t, mut pages), (u, more)| {
+                    pages.extend(more);
+                    (t.add(u), pages)
+                },
+            );
+        if let Ok(mut spare) = self.spare.lock() {
+            spare.extend(swept);
+        }
         self.buckets[b] = bucket;
         tally
     }
     fn peak_bytes(&self) -> u64 {
-        self.buckets
+        let index: usize = self
+            .buckets
             .iter()
-            .map(|b| {
-                let pages = b.pages.iter().filter(|p| p.get().is_some()).count();
-                (pages * PAGE_WORDS * 8
-                    + b.summary.len() * 8
-                    + b.pages.len() * std::mem::size_of::<OnceLock<Box<[AtomicU64]>>>())
-                    as u64
-            })
-            .sum()
+            .map(|b| b.summary.len() * 8 + b.pages.len() * std::mem::size_of::<OnceLock<Page>>())
+            .sum();
+        (self.allocated.load(Relaxed) * PAGE_WORDS * 8 + index) as u64
     }
 }
 
-/// Buckets as vectors; large ones are sorted before they are swept.
-pub(super) struct VecRing {
-    buckets: Vec<Vec<u32>>,
+/// Buckets as vectors of indices `I`; large ones are sorted before they are swept.
+pub(super) struct VecRing<I> {
+    buckets: Vec<Vec<I>>,
     peak: u64,
 }
 
-impl VecRing {
+impl<I: PackedIndex> VecRing<I> {
     /// `ring` empty buckets.
-    pub fn new(ring: usize) -> VecRing {
+    pub fn new(ring: usize) -> VecRing<I> {
         VecRing {
             buckets: vec![Vec::new(); ring],
             peak: 0,
@@ -201,25 +231,26 @@ impl VecRing {
     }
 }
 
-impl Front for VecRing {
+impl<I: PackedIndex> Front<I> for VecRing<I> {
     /// Pushes of one task: (bucket, index).
-    type Local = Vec<(u32, u32)>;
+    type Local = Vec<(u32, I)>;
     #[inline]
-    fn push(&self, local: &mut Vec<(u32, u32)>, tally: &mut Tally, b: usize, idx: u32) {
+    fn push(&self, local: &mut Vec<(u32, I)>, tally: &mut Tally, b: usize, idx: I) {
         local.push((b as u32, idx));
         tally.pushed += 1;
     }
-    fn absorb(&mut self, local: Vec<(u32, u32)>) {
+    fn absorb(&mut self, local: Vec<(u32, I)>) {
         for (b, idx) in local {
             self.buckets[b as usize].push(idx);
         }
     }
     fn sweep<G>(&mut self, b: usize, f: G) -> Tally
     where
-        G: Fn(u32, &Self, &mut Self::Local, &mut Tally, &mut Vec<(u32, u32)>) + Sync,
+        G: Fn(I, &Self, &mut Self::Local, &mut Tally, &mut Vec<(I, u32)>) + Sync,
     {
         let held: usize = self.buckets.iter().map(Vec::capacity).sum();
-        self.peak = self.peak.max(held as u64 * 4);
+        let size = std::mem::size_of::<I>() as u64;
+        self.peak = self.peak.max(held as u64 * size);
         let mut bucket = std::mem::take(&mut self.buckets[b]);
         // Entries of one cost are scattered over the map; in index order they sweep it once,
         // so the cache misses of the settled-check and of nearby origins are shared.
@@ -227,7 +258,7 @@ impl Front for VecRing {
             bucket.par_sort_unstable();
         }
         let this = &*self;
-        let parts: Vec<(Vec<(u32, u32)>, Tally)> = bucket
+        let parts: Vec<(Vec<(u32, I)>, Tally)> = bucket
             .par_chunks(VEC_TASK)
             .with_max_len(1)
             .map(|chunk| {
@@ -243,7 +274,8 @@ impl Front for VecRing {
             .collect();
         let mut tally = Tally::default();
         let pending: usize = parts.iter().map(|(l, _)| l.len()).sum();
-        self.peak = self.peak.max((held + pending * 2) as u64 * 4);
+        let entry = std::mem::size_of::<(u32, I)>() as u64;
+        self.peak = self.peak.max(held as u64 * size + pending as u64 * entry);
         for (local, t) in parts {
             tally = tally.add(t);
             self.absorb(local);

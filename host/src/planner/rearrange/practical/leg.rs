@@ -118,6 +118,9 @@ pub fn legs(
     let start = model
         .pack(&sub.start)
         .ok_or_else(|| ProblemError::Invalid("leg start not free".into()))?;
+    // One movable among fixed others: far fewer than 2³² configurations, so `u32` indices.
+    let start = u32::try_from(start)
+        .map_err(|_| ProblemError::Invalid("a leg's space needs more than u32 indices".into()))?;
     let n = model.n_states as usize;
     let mut dist = vec![u32::MAX; n];
     let mut parent = vec![NONE; n];
@@ -211,7 +214,7 @@ fn leg_to(model: &Model, cur: &Config, i: Option<usize>, parent: &[u32], s: u32,
             MoveKind::Push { .. } => Action::Push(j),
             MoveKind::Rotate { turn, .. } => Action::Rotate(j, turn),
         };
-        let sub = model.unpack(step.to);
+        let sub = model.unpack(step.to as u64);
         let mut config = cur.clone();
         config.robot = sub.robot;
         if model.n_aux > 1 {

@@ -8,7 +8,8 @@
 //!
 //! [`Model`] compiles a problem into dense tables: every body's statically valid placements get
 //! a local index, and a composite configuration Q = (q_𝓡, q_𝓜₁, …, q_𝓜ᵣ) is packed in mixed
-//! radix (robot memory, robot, movable 1, …) into a `u32`. Placements that overlap an obstacle
+//! radix (robot memory, robot, movable 1, …) into one integer ([`PackedIndex`]: a `u32` while the
+//! space has fewer than 2³² configurations, a `u64` past it). Placements that overlap an obstacle
 //! never get an index, so the packed space is the product of the bodies' free placements;
 //! overlaps between bodies (the C-obstacle CCO) are found with precomputed pairwise bit tables.
 //!
@@ -27,4 +28,6 @@ pub use spec::{
     Config, ContactMode, GoalPlacement, MovableSpec, Placement, Problem, ProblemError, RobotSpec,
     Rules, face_modes,
 };
-pub use tables::{Bits, ContactTable, Domain, FastDiv, MAX_MOVABLES, NONE, RotInstance, State};
+pub use tables::{
+    Bits, ContactTable, Domain, FastDiv, MAX_MOVABLES, NONE, PackedIndex, RotInstance, State,
+};

@@ -27,7 +27,7 @@ pub struct Model {
     /// Number of packed configurations.
     pub n_states: u64,
     /// Index stride of each digit: `stride[k] = radix[0] × … × radix[k−1]`.
-    pub stride: Vec<u32>,
+    pub stride: Vec<u64>,
     /// Robot/movable overlap: `rm[i].get(m * n_robot + r)` (movable-major, so the robot's
     /// neighbouring placements share cache lines).
     pub rm: Vec<Bits>,
@@ -146,12 +146,15 @@ impl Model {
             .collect();
         let mut radix = vec![n_aux, robot.len()];
         radix.extend(movables.iter().map(|d| d.len()));
-        let n_states: u64 = radix.iter().map(|&r| r as u64).product();
-        if n_states >= NONE as u64 {
-            return invalid(format!(
-                "{n_states} composite configurations: more than a u32 index holds"
-            ));
-        }
+        let n_states = radix
+            .iter()
+            .try_fold(1u64, |n, &r| n.checked_mul(r as u64))
+            .filter(|&n| usize::try_from(n).is_ok());
+        let Some(n_states) = n_states else {
+            return invalid(
+                "more composite configurations than this machine can address; use --mode practical",
+            );
+        };
         if radix.contains(&0) {
             return invalid("some body has no free placement on this grid");
         }
@@ -277,9 +280,9 @@ impl Model {
             movables,
             stride: radix
                 .iter()
-                .scan(1u32, |acc, &r| {
+                .scan(1u64, |acc, &r| {
                     let s = *acc;
-                    *acc = acc.wrapping_mul(r);
+                    *acc = acc.wrapping_mul(r as u64);
                     Some(s)
                 })
                 .collect(),

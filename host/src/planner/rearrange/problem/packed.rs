@@ -1,11 +1,11 @@
 //! The packed composite configuration space CSS of Ben-Shahar & Rivlin §II-A: a configuration
-//! Q = (q_𝓡, q_𝓜₁, …, q_𝓜ᵣ) as one `u32` in mixed radix, its decoding, the free-space test
+//! Q = (q_𝓡, q_𝓜₁, …, q_𝓜ᵣ) as one integer in mixed radix ([`PackedIndex`]), its decoding, the free-space test
 //! (CCF) and the goal set.
 
 use super::super::grid::Dir;
 use super::model::Model;
 use super::spec::{Config, Placement};
-use super::tables::{Domain, MAX_MOVABLES, NONE, State};
+use super::tables::{Domain, MAX_MOVABLES, NONE, PackedIndex, State};
 
 impl Model {
     /// Grid width.
@@ -21,9 +21,14 @@ impl Model {
         self.movables.len()
     }
 
+    /// Does the packed space need `u64` indices (2³² configurations or more)?
+    pub fn wide(&self) -> bool {
+        self.n_states > u32::MAX as u64
+    }
+
     /// Decode a packed index.
     #[inline]
-    pub fn decode(&self, idx: u32) -> State {
+    pub fn decode<I: PackedIndex>(&self, idx: I) -> State {
         let mut s = State {
             aux: 0,
             r: 0,
@@ -31,23 +36,24 @@ impl Model {
         };
         let mut x = idx;
         if self.n_aux > 1 {
-            (x, s.aux) = self.div[0].div_rem(x);
+            (x, s.aux) = x.div_rem(self.div[0]);
         }
-        (x, s.r) = self.div[1].div_rem(x);
+        (x, s.r) = x.div_rem(self.div[1]);
         for i in 0..self.r() {
-            (x, s.m[i]) = self.div[2 + i].div_rem(x);
+            (x, s.m[i]) = x.div_rem(self.div[2 + i]);
         }
         s
     }
 
     /// Encode local indices.
     #[inline]
-    pub fn encode(&self, s: &State) -> u32 {
-        let mut x = 0u32;
+    pub fn encode<I: PackedIndex>(&self, s: &State) -> I {
+        let mut x = I::from_u64(0);
         for i in (0..self.r()).rev() {
-            x = x * self.radix[2 + i] + s.m[i];
+            x = x.push_digit(self.radix[2 + i], s.m[i]);
         }
-        (x * self.radix[1] + s.r) * self.radix[0] + s.aux
+        x.push_digit(self.radix[1], s.r)
+            .push_digit(self.radix[0], s.aux)
     }
 
     /// Are the two bodies overlapping? (robot vs movable i)
@@ -97,7 +103,7 @@ impl Model {
     }
 
     /// Pack a grid configuration (None if outside CCF).
-    pub fn pack(&self, c: &Config) -> Option<u32> {
+    pub fn pack(&self, c: &Config) -> Option<u64> {
         if c.movables.len() != self.r() {
             return None;
         }
@@ -130,7 +136,7 @@ impl Model {
     }
 
     /// Unpack an index into grid terms.
-    pub fn unpack(&self, idx: u32) -> Config {
+    pub fn unpack(&self, idx: u64) -> Config {
         let s = self.decode(idx);
         let rp = self.robot.place[s.r as usize];
         Config {
@@ -144,7 +150,7 @@ impl Model {
     }
 
     /// The goal set: every configuration in CCF with each body at its goal (or anywhere).
-    pub fn goal_states(&self) -> Vec<u32> {
+    pub fn goal_states(&self) -> Vec<u64> {
         let p = &self.problem;
         let (w, h) = (self.w(), self.h());
         let choices = |dom: &Domain, g: Option<Placement>| -> Vec<u32> {

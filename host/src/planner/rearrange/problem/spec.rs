@@ -206,3 +206,29 @@ pub enum ProblemError {
 pub(super) fn invalid<T>(msg: impl Into<String>) -> Result<T, ProblemError> {
     Err(ProblemError::Invalid(msg.into()))
 }
+
+impl Problem {
+    /// Is `c` in the free space CCF (every body on free cells of the grid, no two overlapping)?
+    /// The same test as packing into a model's tables, for any number of movables.
+    pub fn is_free(&self, c: &Config) -> bool {
+        if c.movables.len() != self.movables.len() {
+            return false;
+        }
+        let g = &self.grid;
+        let mut taken = vec![false; (g.w * g.h).max(0) as usize];
+        let mut place = |cells: Vec<(i32, i32)>, (ax, ay): (i32, i32)| -> bool {
+            cells.into_iter().all(|(x, y)| {
+                let (x, y) = (ax + x, ay + y);
+                if !g.free(x, y) {
+                    return false;
+                }
+                let k = (y * g.w + x) as usize;
+                !std::mem::replace(&mut taken[k], true)
+            })
+        };
+        place(self.robot.cells(), c.robot)
+            && self.movables.iter().zip(&c.movables).all(|(m, p)| {
+                (p.o == 0 || m.rotates && p.o < 4) && place(m.cells_at(p.o), (p.x, p.y))
+            })
+    }
+}

@@ -125,6 +125,10 @@ impl FastDiv {
             d,
         }
     }
+    /// The divisor.
+    pub fn divisor(self) -> u32 {
+        self.d
+    }
     /// `(n / d, n % d)`.
     #[inline(always)]
     pub fn div_rem(self, n: u32) -> (u32, u32) {
@@ -133,6 +137,93 @@ impl FastDiv {
         }
         let q = ((self.m as u128 * n as u128) >> 64) as u32;
         (q, n - q * self.d)
+    }
+}
+
+/// A packed configuration index (§II-A's CSS in mixed radix): `u32` while the space has fewer
+/// than 2³² configurations — every index, and every wave-front entry that holds one, then takes
+/// four bytes — and `u64` past it, for any space that fits in memory.
+pub trait PackedIndex:
+    Copy + Send + Sync + Ord + std::hash::Hash + std::fmt::Debug + 'static
+{
+    /// From a `u64` known to be in range.
+    fn from_u64(x: u64) -> Self;
+    /// As a `u64`.
+    fn as_u64(self) -> u64;
+    /// As an array index.
+    fn as_usize(self) -> usize;
+    /// `(self / d, self % d)`.
+    fn div_rem(self, d: FastDiv) -> (Self, u32);
+    /// `self × radix + digit` (one more digit, below the others).
+    fn push_digit(self, radix: u32, digit: u32) -> Self;
+    /// The index with the digit of stride `stride` changed from `from` to `to`.
+    fn with_digit(self, stride: u32, from: u32, to: u32) -> Self;
+    /// `self + k`.
+    fn plus(self, k: u32) -> Self;
+}
+
+impl PackedIndex for u32 {
+    #[inline(always)]
+    fn from_u64(x: u64) -> u32 {
+        x as u32
+    }
+    #[inline(always)]
+    fn as_u64(self) -> u64 {
+        self as u64
+    }
+    #[inline(always)]
+    fn as_usize(self) -> usize {
+        self as usize
+    }
+    #[inline(always)]
+    fn div_rem(self, d: FastDiv) -> (u32, u32) {
+        d.div_rem(self)
+    }
+    #[inline(always)]
+    fn push_digit(self, radix: u32, digit: u32) -> u32 {
+        self * radix + digit
+    }
+    #[inline(always)]
+    fn with_digit(self, stride: u32, from: u32, to: u32) -> u32 {
+        // The result is in range, so arithmetic modulo 2³² gives it exactly.
+        self.wrapping_add(to.wrapping_sub(from).wrapping_mul(stride))
+    }
+    #[inline(always)]
+    fn plus(self, k: u32) -> u32 {
+        self + k
+    }
+}
+
+impl PackedIndex for u64 {
+    #[inline(always)]
+    fn from_u64(x: u64) -> u64 {
+        x
+    }
+    #[inline(always)]
+    fn as_u64(self) -> u64 {
+        self
+    }
+    #[inline(always)]
+    fn as_usize(self) -> usize {
+        self as usize
+    }
+    #[inline(always)]
+    fn div_rem(self, d: FastDiv) -> (u64, u32) {
+        // The multiply-and-shift holds for 32-bit dividends only; the hardware divides these.
+        let d = d.divisor() as u64;
+        (self / d, (self % d) as u32)
+    }
+    #[inline(always)]
+    fn push_digit(self, radix: u32, digit: u32) -> u64 {
+        self * radix as u64 + digit as u64
+    }
+    #[inline(always)]
+    fn with_digit(self, stride: u32, from: u32, to: u32) -> u64 {
+        self - from as u64 * stride as u64 + to as u64 * stride as u64
+    }
+    #[inline(always)]
+    fn plus(self, k: u32) -> u64 {
+        self + k as u64
     }
 }
 
