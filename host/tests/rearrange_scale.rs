@@ -142,10 +142,44 @@ fn cli_refuses_the_exact_mode_and_picks_the_practical_one_for_many_movables() {
         err.contains("5 movables") && err.contains("--mode practical"),
         "{err}"
     );
-    let (code, out, err) = pushbot(&["plan", "rearrange", "--scene", f, "--json"]);
+    let svg = dir.path().join("five.svg");
+    let svg_arg = svg.to_str().unwrap();
+    let (code, out, err) = pushbot(&[
+        "plan",
+        "rearrange",
+        "--scene",
+        f,
+        "--json",
+        "--svg",
+        svg_arg,
+    ]);
     assert_eq!(code, 0, "{err}");
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(j["mode"], "practical");
+    // The figure: one panel per transit and the pushes after it, every movable drawn.
+    let kinds: Vec<&str> = j["plan"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["kind"].as_str().unwrap())
+        .collect();
+    let stages = (0..kinds.len())
+        .filter(|&i| {
+            let ends_pushes =
+                kinds[i] != "transit" && kinds.get(i + 1).is_none_or(|k| *k == "transit");
+            ends_pushes || i + 1 == kinds.len()
+        })
+        .count();
+    let drawing = std::fs::read_to_string(&svg).unwrap();
+    assert!(stages >= 5, "{kinds:?}");
+    assert_eq!(
+        drawing.matches(" pushes</text>").count(),
+        stages,
+        "{drawing}"
+    );
+    for i in 0..5 {
+        assert!(drawing.contains(&format!(">b{i}</text>")), "b{i} not drawn");
+    }
     assert_eq!(j["optimal"], false);
     for key in ["cost", "steps", "pushes", "plan"] {
         assert!(!j[key].is_null(), "{key} missing in {out}");

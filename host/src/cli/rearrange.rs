@@ -115,15 +115,7 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
     match &result {
         Ok(p) => {
             if args.svg.is_some() || args.png.is_some() {
-                let svg = rearrange::svg::plan_svg(&model, p);
-                if let Some(path) = &args.svg {
-                    std::fs::write(path, &svg).map_err(|e| {
-                        CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display()))
-                    })?;
-                }
-                if let Some(path) = &args.png {
-                    crate::plot::svg_to_png(&svg, path).map_err(CliError::Failed)?;
-                }
+                write_figure(&args, &rearrange::svg::plan_svg(&model, p))?;
             }
             if global.json {
                 let j = json!({
@@ -213,11 +205,6 @@ pub fn plan(global: &Global, args: PlanArgs) -> CliResult {
 /// `plan rearrange` in the practical mode: the same JSON fields as the exact planner's (those
 /// of the map are null), plus `optimal`.
 fn plan_practical(global: &Global, args: &PlanArgs, problem: &Problem) -> CliResult {
-    if args.svg.is_some() || args.png.is_some() {
-        return Err(CliError::bad_input(
-            "--svg and --png draw plans of the exact planner; use --mode exact",
-        ));
-    }
     if !global.json {
         eprintln!(
             "practical mode: {} movables (the exact map would take {} configurations, {})",
@@ -232,6 +219,9 @@ fn plan_practical(global: &Global, args: &PlanArgs, problem: &Problem) -> CliRes
     let peak = peak_kib();
     match result {
         Ok(p) => {
+            if args.svg.is_some() || args.png.is_some() {
+                write_figure(args, &rearrange::svg::practical_svg(problem, &p, None))?;
+            }
             let name = |i: usize| problem.movables[i].name.clone();
             let steps: Vec<serde_json::Value> = p
                 .moves
@@ -325,6 +315,18 @@ fn plan_practical(global: &Global, args: &PlanArgs, problem: &Problem) -> CliRes
             Ok(Status::TaskFailed)
         }
     }
+}
+
+/// Write the plan's figure where `--svg` and `--png` say.
+fn write_figure(args: &PlanArgs, svg: &str) -> Result<(), CliError> {
+    if let Some(path) = &args.svg {
+        std::fs::write(path, svg)
+            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display())))?;
+    }
+    if let Some(path) = &args.png {
+        crate::plot::svg_to_png(svg, path).map_err(CliError::Failed)?;
+    }
+    Ok(())
 }
 
 /// A spinner on stderr while long work runs (hidden with `--json` and off a terminal).

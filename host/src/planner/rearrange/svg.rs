@@ -5,7 +5,8 @@
 //! leaves them (faint where it found them).
 
 use super::admissibility::MoveKind;
-use super::problem::{Config, Model};
+use super::practical::{Action, PracticalPlan};
+use super::problem::{Config, Model, Problem};
 use super::restore::Plan;
 use crate::plot::svg::{Doc, Draw, Group, Style};
 
@@ -15,17 +16,38 @@ const PAD: f64 = 10.0;
 const BLUE: &str = "#1c7ed6";
 const COLORS: [&str; 4] = ["#d9822b", "#2b8a3e", "#7048e8", "#c2255c"];
 
+/// One move of a plan as drawn: does it push, and where it leaves everything.
+#[derive(Debug, Clone, Copy)]
+pub struct Drawn<'a> {
+    /// A pushing move (translational or rotational).
+    pub push: bool,
+    /// The configuration after it.
+    pub config: &'a Config,
+}
+
+/// The moves of an exact plan, for drawing.
+fn drawn(plan: &Plan) -> Vec<Drawn<'_>> {
+    plan.steps
+        .iter()
+        .map(|s| Drawn {
+            push: s.step.kind != MoveKind::Transit,
+            config: &s.config,
+        })
+        .collect()
+}
+
 /// The plan's stages: index ranges of steps, each transit moves then push moves.
 pub fn stages(plan: &Plan) -> Vec<std::ops::Range<usize>> {
+    stages_of(&drawn(plan))
+}
+
+/// Stages of drawn moves: each transit moves then push moves.
+fn stages_of(moves: &[Drawn]) -> Vec<std::ops::Range<usize>> {
     let mut out = Vec::new();
     let mut start = 0;
-    for i in 0..plan.steps.len() {
-        let push = plan.steps[i].step.kind != MoveKind::Transit;
-        let next_transit = plan
-            .steps
-            .get(i + 1)
-            .is_none_or(|s| s.step.kind == MoveKind::Transit);
-        if (push && next_transit) || i + 1 == plan.steps.len() {
+    for i in 0..moves.len() {
+        let next_transit = moves.get(i + 1).is_none_or(|s| !s.push);
+        if (moves[i].push && next_transit) || i + 1 == moves.len() {
             out.push(start..i + 1);
             start = i + 1;
         }
@@ -40,9 +62,9 @@ fn centre(x: i32, y: i32, size: i32) -> [f64; 2] {
     ]
 }
 
-fn draw_movables(g: &mut Group, model: &Model, c: &Config, opacity: f64, outline_only: bool) {
+fn draw_movables(g: &mut Group, problem: &Problem, c: &Config, opacity: f64, outline_only: bool) {
     for (i, p) in c.movables.iter().enumerate() {
-        let spec = &model.problem.movables[i];
+        let spec = &problem.movables[i];
         let col = COLORS[i % COLORS.len()];
         let style = if outline_only {
             Style::outline(col, 1.5).dash("3,2")
@@ -61,9 +83,9 @@ fn draw_movables(g: &mut Group, model: &Model, c: &Config, opacity: f64, outline
     }
 }
 
-fn panel(g: &mut Group, model: &Model, before: &Config, steps: &[&Config], title: &str) {
-    let grid = &model.problem.grid;
-    let k = model.problem.robot.size;
+fn panel(g: &mut Group, problem: &Problem, before: &Config, steps: &[&Config], title: &str) {
+    let grid = &problem.grid;
+    let k = problem.robot.size;
     g.text([0.0, -3.0], title, &Style::new().font_size(11.0));
     for y in 0..grid.h {
         for x in 0..grid.w {
@@ -90,9 +112,9 @@ fn panel(g: &mut Group, model: &Model, before: &Config, steps: &[&Config], title
         robot: (0, 0),
         heading: before.heading,
         pushing: false,
-        movables: (0..model.r())
+        movables: (0..problem.movables.len())
             .map(|i| {
-                model.problem.goal_movables[i].unwrap_or(super::problem::Placement {
+                problem.goal_movables[i].unwrap_or(super::problem::Placement {
                     x: -100,
                     y: -100,
                     o: 0,
@@ -100,10 +122,10 @@ fn panel(g: &mut Group, model: &Model, before: &Config, steps: &[&Config], title
             })
             .collect(),
     };
-    draw_movables(g, model, &goal, 1.0, true);
-    draw_movables(g, model, before, 0.25, false);
+    draw_movables(g, problem, &goal, 1.0, true);
+    draw_movables(g, problem, before, 0.25, false);
     let last = steps.last().copied().unwrap_or(before);
-    draw_movables(g, model, last, 0.9, false);
+    draw_movables(g, problem, last, 0.9, false);
     // robot path
     let mut pts = vec![centre(before.robot.0, before.robot.1, k)];
     pts.extend(steps.iter().map(|c| centre(c.robot.0, c.robot.1, k)));
@@ -131,28 +153,46 @@ pub fn plan_svg(model: &Model, plan: &Plan) -> String {
 /// [`plan_svg`] with axes in metres on every panel when the grid's cells are `cell` metres
 /// wide (row 0 along the table's far edge, so y counts up from the last row).
 pub fn plan_svg_in(model: &Model, plan: &Plan, cell: Option<f64>) -> String {
-    let grid = &model.problem.grid;
+    moves_svg(&model.problem, &plan.start, &drawn(plan), cell)
+}
+
+/// A practical-mode plan drawn the same way (one panel per transit and the pushes after it).
+pub fn practical_svg(problem: &Problem, plan: &PracticalPlan, cell: Option<f64>) -> String {
+    let moves: Vec<Drawn> = plan
+        .moves
+        .iter()
+        .map(|m| Drawn {
+            push: m.action != Action::Transit,
+            config: &m.config,
+        })
+        .collect();
+    moves_svg(problem, &plan.start, &moves, cell)
+}
+
+/// Panels of drawn moves from `start`.
+fn moves_svg(problem: &Problem, start: &Config, moves: &[Drawn], cell: Option<f64>) -> String {
+    let grid = &problem.grid;
     // Room for the axes' labels on the left and below.
     let (left, below) = if cell.is_some() {
         (34.0, 18.0)
     } else {
         (0.0, 0.0)
     };
-    let st = stages(plan);
+    let st = stages_of(moves);
     let panels = st.len().max(1);
     let cols = panels.min(3);
     let rows = panels.div_ceil(cols);
     let pw = grid.w as f64 * CELL + 2.0 * PAD + left;
     let ph = grid.h as f64 * CELL + 2.0 * PAD + 14.0 + below;
     let mut d = Doc::new(cols as f64 * pw, rows as f64 * ph);
-    d.title(&model.problem.name);
+    d.title(&problem.name);
     d.arrow_marker("arrow", BLUE);
     d.background(&Style::new().fill("white"));
-    let mut before = plan.start.clone();
+    let mut before = start.clone();
     if st.is_empty() {
         let mut g = Group::translated(PAD + left, PAD + 14.0);
-        let title = format!("{}: already at the goal", model.problem.name);
-        panel(&mut g, model, &before, &[], &title);
+        let title = format!("{}: already at the goal", problem.name);
+        panel(&mut g, problem, &before, &[], &title);
         if let Some(c) = cell {
             axes(&mut g, grid.w, grid.h, c);
         }
@@ -161,22 +201,16 @@ pub fn plan_svg_in(model: &Model, plan: &Plan, cell: Option<f64>) -> String {
     for (n, range) in st.iter().enumerate() {
         let (col, row) = (n % cols, n / cols);
         let mut g = Group::translated(col as f64 * pw + PAD + left, row as f64 * ph + PAD + 14.0);
-        let cfgs: Vec<&Config> = plan.steps[range.clone()]
-            .iter()
-            .map(|p| &p.config)
-            .collect();
-        let pushes = plan.steps[range.clone()]
-            .iter()
-            .filter(|p| p.step.kind != MoveKind::Transit)
-            .count();
+        let cfgs: Vec<&Config> = moves[range.clone()].iter().map(|p| p.config).collect();
+        let pushes = moves[range.clone()].iter().filter(|p| p.push).count();
         let title = format!(
             "{} step {}: {} moves, {} pushes",
-            model.problem.name,
+            problem.name,
             n + 1,
             range.len(),
             pushes
         );
-        panel(&mut g, model, &before, &cfgs, &title);
+        panel(&mut g, problem, &before, &cfgs, &title);
         if let Some(c) = cell {
             axes(&mut g, grid.w, grid.h, c);
         }
