@@ -265,7 +265,7 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
             &mut |res: &StartResult| {
                 if !global.json {
                     println!(
-                        "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?}",
+                        "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?} | stalls recovered {}",
                         scene.name,
                         res.start,
                         format!("{:?}", res.method),
@@ -275,6 +275,7 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
                         res.mean_object_path_m
                             .map_or("-".into(), |t| format!("{t:.2} m")),
                         res.failures,
+                        res.stall_recoveries,
                     );
                 }
             },

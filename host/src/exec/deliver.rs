@@ -46,6 +46,13 @@ pub struct DeliveryParams {
     pub boundary_guard: f64,
     /// Strength of that pull at the boundary, relative to the unit goal direction.
     pub boundary_pull: f64,
+    /// Stall: the object came no closer to the goal by [`Self::stall_progress`] (or half the
+    /// way still left to the success radius, if less) for this long, s; 0 turns it off (as in
+    /// the paper, and for deliveries on a clear table). Deliveries among obstacles set it
+    /// ([`crate::planner::global::ObstacleParams::stall_time`]) and recover.
+    pub stall_time: f64,
+    /// Progress towards the goal that counts against a stall, m.
+    pub stall_progress: f64,
     /// Dipole baseline: length of one drive step, s.
     pub dipole_step: f64,
     /// Dipole baseline: controller parameters.
@@ -65,6 +72,8 @@ impl Default for DeliveryParams {
             bound_all_margin: 0.02,
             boundary_guard: 0.06,
             boundary_pull: 1.0,
+            stall_time: 0.0,
+            stall_progress: 0.02,
             dipole_step: 0.25,
             dipole: DipoleParams::default(),
         }
@@ -85,6 +94,21 @@ pub enum Failure {
     NoStrategy,
     /// Among obstacles: no global path for the object.
     NoPath,
+    /// No progress towards the goal for the stall time, after every recovery was tried.
+    Stalled,
+}
+
+/// A stall among obstacles and what was done about it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Recovery {
+    /// When the stall was detected, s since the delivery started.
+    pub t: f64,
+    /// Where the object's marker was, table frame, m.
+    pub at: [f64; 2],
+    /// The sub-goal it was being pushed to.
+    pub subgoal: [f64; 2],
+    /// What was tried: "back off and re-plan", then with closer sub-goals.
+    pub action: String,
 }
 
 /// How one delivery went.
@@ -100,6 +124,8 @@ pub struct Delivery {
     pub steps: usize,
     /// Times the robot re-positioned itself (special case).
     pub repositions: usize,
+    /// Stalls detected and the recoveries tried (among obstacles).
+    pub recoveries: Vec<Recovery>,
     /// Path length of the object's marker, m.
     pub object_path: f64,
     /// Path length of the robot, m.
@@ -220,6 +246,7 @@ fn finish(
         time: io.time() - start,
         steps,
         repositions,
+        recoveries: Vec::new(),
         object_path: path_len(&trajectory, |t| t.1),
         robot_path: path_len(&trajectory, |t| t.0),
         final_distance: (goal - o.position()).norm(),
@@ -303,6 +330,7 @@ pub fn deliver_learned_among(
         let (r, o) = (io.robot_pose(), io.object_pose());
         (r.position() - o.position()).norm() > bound_all
     };
+    let mut stall = StallWatch::new(p, start);
     loop {
         let (r, o) = (io.robot_pose(), io.object_pose());
         traj.push((r, o));
@@ -311,6 +339,10 @@ pub fn deliver_learned_among(
         }
         let to_goal = goal - o.position();
         let dist = to_goal.norm();
+        if stall.stalled(dist, io.time()) {
+            let v = Err(Failure::Stalled);
+            return Ok(finish(io, start, goal, v, steps, repositions, traj));
+        }
         let bias = boundary_bias(&ws.boundary, o.position(), goal, p);
         let want_world = to_goal / dist + bias;
         let want = o.vector_to_local(want_world.normalize());
@@ -402,6 +434,37 @@ pub fn deliver_learned_among(
         special = moved.norm() < p.moved_epsilon
             || moved.dot(&(goal - o0.position())) < 0.0
             || moved.dot(&bias) < 0.0;
+    }
+}
+
+/// Watches the distance to the goal for a stall ([`DeliveryParams::stall_time`]).
+struct StallWatch {
+    time: f64,
+    progress: f64,
+    success: f64,
+    best: f64,
+    best_at: f64,
+}
+
+impl StallWatch {
+    fn new(p: &DeliveryParams, now: f64) -> StallWatch {
+        StallWatch {
+            time: p.stall_time,
+            progress: p.stall_progress,
+            success: p.success_radius,
+            best: f64::INFINITY,
+            best_at: now,
+        }
+    }
+
+    /// The object is `dist` from the goal at `now`: has it made no progress for too long?
+    fn stalled(&mut self, dist: f64, now: f64) -> bool {
+        let need = self.progress.min(0.5 * (self.best - self.success));
+        if !self.best.is_finite() || self.best - dist >= need {
+            self.best = dist;
+            self.best_at = now;
+        }
+        self.time > 0.0 && now - self.best_at > self.time
     }
 }
 

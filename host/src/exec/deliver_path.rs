@@ -3,11 +3,17 @@
 //! and Algorithm 2 ([`crate::strategy::deliver::deliver_learned_among`]) pushing to the path's
 //! point `subgoal_spacing` ahead (a sub-goal, reached within `subgoal_radius`), until the last
 //! leg reaches the goal within the success radius.
+//!
+//! A leg that makes no progress towards its sub-goal for `stall_time` (the object caught on a
+//! corner, the path looping) is a **stall**, never a silent time-out: the robot backs off the
+//! object, the path is planned again from the object's measured pose, and the sub-goals come
+//! closer together (halved at each stall in a row). Each recovery is recorded
+//! ([`Recovery`]); after `max_recoveries` the delivery fails as stalled.
 
 use anyhow::Result;
 use nalgebra::Vector2;
 
-use crate::exec::deliver::{Delivery, DeliveryParams, Failure, deliver_learned_among};
+use crate::exec::deliver::{Delivery, DeliveryParams, Failure, Recovery, deliver_learned_among};
 use crate::exec::io::RobotIo;
 use crate::planner::global::{ObstacleParams, plan_object_path, point_along};
 use crate::strategy::regression::PushStrategy;
@@ -43,6 +49,7 @@ pub fn deliver_among_obstacles(
         time: 0.0,
         steps: 0,
         repositions: 0,
+        recoveries: Vec::new(),
         object_path: 0.0,
         robot_path: 0.0,
         final_distance: f64::NAN,
@@ -51,6 +58,9 @@ pub fn deliver_among_obstacles(
     let mut subgoals = Vec::new();
     let mut first_path = Vec::new();
     let mut legs = 0;
+    // Sub-goal spacing: halved at each stall in a row, back to the default after progress.
+    let mut spacing = op.subgoal_spacing;
+    let mut stalls_in_a_row = 0;
     loop {
         let o = io.object_pose().position();
         let left = params.time_limit - (io.time() - start);
@@ -64,16 +74,17 @@ pub fn deliver_among_obstacles(
             first_path = shown;
         }
         let length: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-        let last = length <= op.subgoal_spacing * 1.5;
+        let last = length <= spacing * 1.5;
         let sub = if last {
             goal
         } else {
-            point_along(&path, op.subgoal_spacing).unwrap_or(goal)
+            point_along(&path, spacing).unwrap_or(goal)
         };
         subgoals.push([sub.x, sub.y]);
         let leg_params = if last {
             DeliveryParams {
                 time_limit: left,
+                stall_time: op.stall_time,
                 ..*params
             }
         } else {
@@ -81,6 +92,7 @@ pub fn deliver_among_obstacles(
                 time_limit: left,
                 success_radius: op.subgoal_radius,
                 fine_radius: op.subgoal_radius,
+                stall_time: op.stall_time,
                 ..*params
             }
         };
@@ -91,10 +103,44 @@ pub fn deliver_among_obstacles(
         all.object_path += d.object_path;
         all.robot_path += d.robot_path;
         all.trajectory.extend(d.trajectory);
+        if d.failure == Some(Failure::Stalled) {
+            let o = io.object_pose().position();
+            if all.recoveries.len() >= op.max_recoveries {
+                tracing::warn!(
+                    "delivery stalled at ({:.3}, {:.3}) after {} recoveries: giving up",
+                    o.x,
+                    o.y,
+                    all.recoveries.len()
+                );
+                all.failure = Some(Failure::Stalled);
+                break;
+            }
+            stalls_in_a_row += 1;
+            spacing =
+                (op.subgoal_spacing / 2f64.powi(stalls_in_a_row)).max(1.5 * op.subgoal_radius);
+            let action = format!("back off and re-plan, sub-goals every {spacing:.3} m");
+            tracing::info!(
+                "delivery stalled at ({:.3}, {:.3}) pushing to ({:.3}, {:.3}): {action}",
+                o.x,
+                o.y,
+                sub.x,
+                sub.y
+            );
+            all.recoveries.push(Recovery {
+                t: io.time() - start,
+                at: [o.x, o.y],
+                subgoal: [sub.x, sub.y],
+                action,
+            });
+            back_off(io, op)?;
+            continue;
+        }
         if !d.success {
             all.failure = d.failure;
             break;
         }
+        spacing = op.subgoal_spacing;
+        stalls_in_a_row = 0;
         if last {
             all.success = true;
             break;
@@ -111,4 +157,17 @@ pub fn deliver_among_obstacles(
         subgoals,
         path: first_path,
     })
+}
+
+/// Back the robot off the object it stalled against: straight back by the object's clearance
+/// margin plus a robot radius, where the table leaves room.
+fn back_off(io: &mut dyn RobotIo, op: &ObstacleParams) -> Result<()> {
+    let ws = io.workspace();
+    let r = io.robot_pose();
+    let back = ws.robot_radius + op.room_margin;
+    let behind = r.position() - back * nalgebra::Vector2::new(r.theta.cos(), r.theta.sin());
+    if ws.table.inset(ws.robot_radius + 0.005).contains(behind) {
+        io.forward(-back)?;
+    }
+    Ok(())
 }

@@ -46,6 +46,15 @@ pub fn instances(quick: bool) -> Vec<Instance> {
     ]
 }
 
+/// The first room past a `u32` index: robot + 3 boxes on 16 × 16, 2³² configurations (the map
+/// takes about 9 GiB), run only when asked for (`--only wide`).
+pub fn wide_instance() -> Instance {
+    Instance {
+        key: "wide",
+        problem: bench_problem(16, 3),
+    }
+}
+
 /// A benchmark room: `side × side`, no inner obstacles, the robot and `boxes` one-cell boxes of
 /// mass 1, one box at a time; goals in a row along the bottom, the robot anywhere.
 pub fn bench_problem(side: i32, boxes: usize) -> Problem {

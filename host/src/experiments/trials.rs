@@ -37,6 +37,8 @@ pub struct StartResult {
     pub mean_robot_path_m: Option<f64>,
     /// Failures by reason.
     pub failures: BTreeMap<String, usize>,
+    /// Stalls recovered from (or given up on) over all trials (deliveries among obstacles).
+    pub stall_recoveries: usize,
 }
 
 fn mean(xs: impl Iterator<Item = f64>) -> Option<f64> {
@@ -71,6 +73,7 @@ pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult 
         mean_object_path_m: mean(ok.iter().map(|d| d.object_path)),
         mean_robot_path_m: mean(ok.iter().map(|d| d.robot_path)),
         failures,
+        stall_recoveries: runs.iter().map(|d| d.recoveries.len()).sum(),
     }
 }
 

@@ -34,6 +34,10 @@ pub struct ObstacleParams {
     pub subgoal_spacing: f64,
     /// A sub-goal (not the goal) counts as reached within this distance, m.
     pub subgoal_radius: f64,
+    /// A leg stalls when the object comes no closer to its sub-goal for this long, s.
+    pub stall_time: f64,
+    /// Recoveries tried before a delivery is given up as stalled.
+    pub max_recoveries: usize,
 }
 
 impl Default for ObstacleParams {
@@ -45,6 +49,8 @@ impl Default for ObstacleParams {
             room_penalty: 4,
             subgoal_spacing: 0.15,
             subgoal_radius: 0.04,
+            stall_time: 60.0,
+            max_recoveries: 4,
         }
     }
 }

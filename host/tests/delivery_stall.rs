@@ -1,0 +1,163 @@
+//! Stalls in a delivery among obstacles (Lau, Mitani & Igarashi §III-E, with a global path):
+//! when the object stops coming closer to its sub-goal, the delivery detects it, backs off,
+//! plans again from where the object is and records the recovery — never a silent time-out.
+//! The stall is made real: for a while the robot's pushes do not move it (it stands, as a
+//! robot whose wheels slip on the spot), on the simulated robot in process.
+
+use anyhow::Result;
+use indicatif::ProgressBar;
+use nalgebra::Vector2;
+use pushbot::exec::collect::{CollectParams, collect};
+use pushbot::exec::deliver::{DeliveryParams, Failure};
+use pushbot::exec::deliver_path::deliver_among_obstacles;
+use pushbot::exec::io::{RobotIo, Workspace};
+use pushbot::planner::global::{ObstacleParams, scene_obstacles};
+use pushbot::sim::robot::{SimRobot, SimRobotOptions};
+use pushbot::strategy::regression::{KernelParams, PushStrategy};
+use pushbot::strategy::sample::Pose2;
+use pushbot_sim::Scene;
+
+/// The simulated robot, except that from `from` s on (until `until`) its forward drives do
+/// not move it: it stands for as long as the drive would have taken.
+struct Slipping {
+    inner: SimRobot,
+    from: f64,
+    until: f64,
+}
+
+impl RobotIo for Slipping {
+    fn spin(&mut self, angle: f64) -> Result<()> {
+        self.inner.spin(angle)
+    }
+    fn forward(&mut self, distance: f64) -> Result<()> {
+        let t = self.inner.time();
+        if distance > 0.0 && t >= self.from && t < self.until {
+            let speed = SimRobotOptions::default().speed;
+            return self.inner.drive(0.0, 0.0, distance / speed + 0.5);
+        }
+        self.inner.forward(distance)
+    }
+    fn drive(&mut self, v: f64, omega: f64, duration: f64) -> Result<()> {
+        self.inner.drive(v, omega, duration)
+    }
+    fn robot_pose(&mut self) -> Pose2 {
+        self.inner.robot_pose()
+    }
+    fn object_pose(&mut self) -> Pose2 {
+        self.inner.object_pose()
+    }
+    fn body_pose(&mut self, id: &str) -> Option<Pose2> {
+        self.inner.body_pose(id)
+    }
+    fn time(&self) -> f64 {
+        self.inner.time()
+    }
+    fn workspace(&self) -> Workspace {
+        self.inner.workspace()
+    }
+}
+
+/// A strategy of 160 random pushes of the irregular object on the clear table.
+fn strategy() -> PushStrategy {
+    let mut clear = Scene::preset("lau-obstacles").unwrap();
+    clear.obstacles.clear();
+    let opts = SimRobotOptions {
+        seed: 4,
+        ..SimRobotOptions::default()
+    };
+    let mut io = SimRobot::new(clear, None, None, opts).unwrap();
+    let mut strat = PushStrategy::new(Vec::new(), KernelParams::default());
+    let params = CollectParams {
+        initial: 160,
+        streak: 0,
+        max_queries: 0,
+        seed: 4,
+        ..CollectParams::default()
+    };
+    collect(
+        &mut io,
+        &mut strat,
+        &params,
+        &mut |_| Ok(()),
+        &ProgressBar::hidden(),
+    )
+    .unwrap();
+    strat
+}
+
+/// Deliver around `lau-obstacles`' wall with the robot slipping from 20 s of the delivery on,
+/// for `slip` s.
+fn deliver_slipping(slip: f64, op: &ObstacleParams) -> pushbot::exec::deliver::Delivery {
+    let scene = Scene::preset("lau-obstacles").unwrap();
+    let wall = scene_obstacles(&scene);
+    let opts = SimRobotOptions {
+        seed: 4,
+        ..SimRobotOptions::default()
+    };
+    let inner = SimRobot::new(scene, None, None, opts).unwrap();
+    let t0 = inner.time();
+    let mut io = Slipping {
+        inner,
+        from: t0 + 20.0,
+        until: t0 + 20.0 + slip,
+    };
+    let mut strat = strategy();
+    let goal = Vector2::new(1.25, 0.6);
+    let params = DeliveryParams::default();
+    let out = deliver_among_obstacles(&mut io, &mut strat, goal, &wall, &params, op, &mut |_| {
+        Ok(())
+    })
+    .unwrap();
+    eprintln!(
+        "{:?}, {:.0} s, recoveries {:#?}",
+        out.delivery.failure, out.delivery.time, out.delivery.recoveries
+    );
+    out.delivery
+}
+
+#[test]
+fn a_stall_is_detected_recovered_from_and_reported() {
+    let op = ObstacleParams::default();
+    // Slipping for 80 s: longer than the stall time (60 s), shorter than two.
+    let d = deliver_slipping(80.0, &op);
+    assert!(d.success, "{:?}", d.failure);
+    assert!(!d.recoveries.is_empty(), "the stall went unnoticed");
+    let first = &d.recoveries[0];
+    // Detected once the stall time had passed since the slipping began (at 20 s), not before.
+    assert!(first.t > 20.0 + op.stall_time, "{first:?}");
+    assert!(first.t < 20.0 + 80.0 + op.stall_time, "{first:?}");
+    assert!(first.action.contains("back off and re-plan"), "{first:?}");
+}
+
+#[test]
+fn a_stall_that_does_not_clear_fails_as_stalled_not_as_a_time_out() {
+    let op = ObstacleParams {
+        max_recoveries: 2,
+        ..ObstacleParams::default()
+    };
+    let d = deliver_slipping(f64::INFINITY, &op);
+    assert_eq!(d.failure, Some(Failure::Stalled));
+    assert_eq!(d.recoveries.len(), 2, "{:?}", d.recoveries);
+    // Sub-goals come closer at each stall in a row (0.15 m → 0.075 → 0.06, 1.5 sub-goal radii).
+    assert!(
+        d.recoveries[0].action.contains("0.075"),
+        "{:?}",
+        d.recoveries
+    );
+    assert!(
+        d.recoveries[1].action.contains("0.060"),
+        "{:?}",
+        d.recoveries
+    );
+    // Given up after the stall time three times (and the 20 s before), not at the time limit.
+    assert!(d.time < 20.0 + 3.0 * (op.stall_time + 10.0), "{}", d.time);
+    assert!(d.time < DeliveryParams::default().time_limit, "{}", d.time);
+}
+
+#[test]
+fn a_delivery_that_keeps_moving_has_no_stall() {
+    let op = ObstacleParams::default();
+    let d = deliver_slipping(0.0, &op);
+    assert!(d.success, "{:?}", d.failure);
+    assert!(d.recoveries.is_empty(), "{:?}", d.recoveries);
+}
