@@ -7,7 +7,8 @@
 //! A leg that makes no progress towards its sub-goal for `stall_time` (the object caught on a
 //! corner, the path looping) is a **stall**, never a silent time-out: the robot backs off the
 //! object, the path is planned again from the object's measured pose, and the sub-goals come
-//! closer together (halved at each stall in a row). Each recovery is recorded
+//! closer together (halved at each stall in a row); from the second stall in a row the object
+//! is first pushed a little from a side the robot can reach. Each recovery is recorded
 //! ([`Recovery`]); after `max_recoveries` the delivery fails as stalled.
 
 use anyhow::Result;
@@ -15,7 +16,10 @@ use nalgebra::Vector2;
 
 use crate::exec::deliver::{Delivery, DeliveryParams, Failure, Recovery, deliver_learned_among};
 use crate::exec::io::RobotIo;
-use crate::planner::global::{ObstacleParams, plan_object_path, point_along};
+use crate::exec::io::Workspace;
+use crate::planner::global::{
+    ObstacleParams, clearance, plan_object_path, point_along, robot_fits,
+};
 use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::Sample;
 
@@ -118,7 +122,18 @@ pub fn deliver_among_obstacles(
             stalls_in_a_row += 1;
             spacing =
                 (op.subgoal_spacing / 2f64.powi(stalls_in_a_row)).max(1.5 * op.subgoal_radius);
-            let action = format!("back off and re-plan, sub-goals every {spacing:.3} m");
+            // A second stall in a row: the robot cannot get behind the object for the way the
+            // path wants; push it a little from a side it can reach, then plan again.
+            let aside = (stalls_in_a_row > 1)
+                .then(|| side_step(&ws, obstacles, o, sub - o, op))
+                .flatten();
+            let action = match aside {
+                Some(t) => format!(
+                    "back off, push to ({:.3}, {:.3}) from a side the robot can reach, re-plan, sub-goals every {spacing:.3} m",
+                    t.x, t.y
+                ),
+                None => format!("back off and re-plan, sub-goals every {spacing:.3} m"),
+            };
             tracing::info!(
                 "delivery stalled at ({:.3}, {:.3}) pushing to ({:.3}, {:.3}): {action}",
                 o.x,
@@ -133,6 +148,22 @@ pub fn deliver_among_obstacles(
                 action,
             });
             back_off(io, op)?;
+            if let Some(t) = aside {
+                let left = params.time_limit - (io.time() - start);
+                let side = DeliveryParams {
+                    time_limit: left.min(op.stall_time),
+                    success_radius: op.subgoal_radius / 2.0,
+                    fine_radius: op.subgoal_radius,
+                    stall_time: op.stall_time / 2.0,
+                    ..*params
+                };
+                let d = deliver_learned_among(io, strategy, t, &side, obstacles, sink)?;
+                all.steps += d.steps;
+                all.repositions += d.repositions;
+                all.object_path += d.object_path;
+                all.robot_path += d.robot_path;
+                all.trajectory.extend(d.trajectory);
+            }
             continue;
         }
         if !d.success {
@@ -170,4 +201,36 @@ fn back_off(io: &mut dyn RobotIo, op: &ObstacleParams) -> Result<()> {
         io.forward(-back)?;
     }
     Ok(())
+}
+
+/// How far a recovery pushes the object aside, m.
+const SIDE_STEP: f64 = 0.08;
+
+/// Where to push an object at `o` that stalled while wanted along `want`: of sixteen
+/// directions, those where the robot can stand behind the object (on its bound-all circle) and
+/// the object ends no closer to an obstacle than its clearance (or than it is now), the one
+/// nearest to `want`.
+fn side_step(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    o: Vector2<f64>,
+    want: Vector2<f64>,
+    op: &ObstacleParams,
+) -> Option<Vector2<f64>> {
+    let want = want.try_normalize(1e-9)?;
+    let behind = ws.object_radius + ws.robot_radius + 0.03;
+    let keep = clearance(o, obstacles).min(ws.object_radius + op.object_margin);
+    (0..16)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / 16.0;
+            Vector2::new(a.cos(), a.sin())
+        })
+        .filter(|d| {
+            let t = o + d * SIDE_STEP;
+            robot_fits(ws, obstacles, o - d * behind)
+                && ws.boundary.contains(t)
+                && clearance(t, obstacles) >= keep
+        })
+        .max_by(|a, b| a.dot(&want).total_cmp(&b.dot(&want)))
+        .map(|d| o + d * SIDE_STEP)
 }

@@ -1,5 +1,6 @@
 //! The maneuvers every executor drives, written once: turn to a heading ([`face`]), drive the
-//! robot's centre to a point ([`go_to`]), and walk around an object on a circle ([`circle_walk`],
+//! robot's centre to a point ([`go_to`]; around obstacles, [`transit`]), and walk around an
+//! object on a circle ([`circle_walk`],
 //! Lau, Mitani & Igarashi Fig. 3). Each measures with the camera ([`RobotIo::robot_pose`]) and
 //! acts with primitives (spin, forward); how often it measures and corrects is the caller's
 //! [`Turn`] and [`Drive`]: the paper's two-level motion (§IV: a coarse spin corrected once at a
@@ -9,7 +10,7 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use crate::exec::io::RobotIo;
-use crate::planner::global::robot_fits;
+use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
 use crate::strategy::sample::{Pose2, wrap_angle};
 
 /// How to turn to a heading: up to `tries` spins, each from a fresh measurement, stopping once
@@ -156,6 +157,36 @@ pub fn go_to(io: &mut dyn RobotIo, target: Vector2<f64>, drive: &Drive) -> Resul
     Ok(())
 }
 
+/// Drive the robot's centre to `target` around `obstacles`: straight when the way is clear,
+/// else along a path planned around them ([`plan_robot_path`]); straight when there is none.
+pub fn transit(
+    io: &mut dyn RobotIo,
+    target: Vector2<f64>,
+    obstacles: &[Vec<[f64; 2]>],
+    drive: &Drive,
+) -> Result<()> {
+    let ws = io.workspace();
+    let here = io.robot_pose().position();
+    if obstacles.is_empty() || segment_clear(&ws, obstacles, here, target) {
+        return go_to(io, target, drive);
+    }
+    match plan_robot_path(&ws, obstacles, here, target) {
+        Some(path) => {
+            tracing::debug!(
+                "transit around obstacles: {} way points to ({:.3}, {:.3})",
+                path.len() - 1,
+                target.x,
+                target.y
+            );
+            for p in &path[1..] {
+                go_to(io, *p, drive)?;
+            }
+            Ok(())
+        }
+        None => go_to(io, target, drive),
+    }
+}
+
 /// Move the robot around the circle of radius `radius` about `centre` (Fig. 3 a–c): first to
 /// the circle's closest point, then along it in chords of at most 30° to the point at angle
 /// `to`, going the way that keeps the robot on the table and off the `obstacles` (points the
@@ -190,7 +221,21 @@ pub fn circle_walk(
         let back = clamp(on(from)) - io.robot_pose().position();
         io.forward(-back.norm())?;
     } else {
-        go_to(io, clamp(on(from)), &Drive::two_level(tol))?;
+        // From afar, around the obstacles and the object itself (a disc inside the circle).
+        let mut around = obstacles.to_vec();
+        let inner = radius - ws.robot_radius - 0.015;
+        if inner > 0.0 && !obstacles.is_empty() {
+            around.push(
+                (0..12)
+                    .map(|k| {
+                        let a = k as f64 * std::f64::consts::TAU / 12.0;
+                        let p = centre + inner * Vector2::new(a.cos(), a.sin());
+                        [p.x, p.y]
+                    })
+                    .collect(),
+            );
+        }
+        transit(io, clamp(on(from)), &around, &Drive::two_level(tol))?;
     }
     let delta = wrap_angle(to - from);
     let other = if delta >= 0.0 {

@@ -10,7 +10,11 @@
 //! is a cost, not a wall: cells where the robot could not circle the object on its bound-all
 //! circle (Fig. 3) — closer to an obstacle than the object's radius plus the robot's diameter
 //! plus a margin — cost `room_penalty` times as much, so the path keeps that room wherever the
-//! free space allows and squeezes through only where it must.
+//! free space allows and squeezes through only where it must. A move also needs the robot's
+//! room *behind* the object for that direction of push (its centre on the far side of the
+//! bound-all circle, clear of obstacles and on the table): a move without it costs
+//! `behind_penalty` times as much, so an object against a wall is taken along the wall, where
+//! the robot can push, and not straight off it, where it cannot stand.
 
 use anyhow::{Result, anyhow};
 use nalgebra::Vector2;
@@ -30,6 +34,8 @@ pub struct ObstacleParams {
     pub room_margin: f64,
     /// Cost factor of cells without room for the robot to circle the object.
     pub room_penalty: u32,
+    /// Cost factor of moves without room for the robot behind the object (1: not checked).
+    pub behind_penalty: u32,
     /// Distance along the path to the next sub-goal, m.
     pub subgoal_spacing: f64,
     /// A sub-goal (not the goal) counts as reached within this distance, m.
@@ -47,6 +53,7 @@ impl Default for ObstacleParams {
             object_margin: 0.01,
             room_margin: 0.02,
             room_penalty: 4,
+            behind_penalty: 8,
             subgoal_spacing: 0.15,
             subgoal_radius: 0.04,
             stall_time: 60.0,
@@ -107,6 +114,10 @@ impl Clearances {
     }
 }
 
+/// How far an object that stands too close to an obstacle may be pushed off it to where the
+/// path begins, m.
+const ESCAPE: f64 = 0.15;
+
 /// A global path for the object's marker from `start` to `goal` among `obstacles` (table-frame
 /// polygons), inside the workspace's boundary; `None` when there is none. The path runs from
 /// `start` to `goal` through grid cell centres.
@@ -154,11 +165,40 @@ pub fn plan_object_path(
         })
         .collect();
     let at = |(i, j): (i32, i32)| factor[(j * nx + i) as usize];
-    let (s, g) = (cell_of(start), cell_of(goal));
-    // The start and goal cells may be in the soft zone, never blocked for the search to begin.
+    // Can the robot stand behind an object at `x` to push it along `d`?
+    let behind = ws.object_radius + ws.robot_radius + p.room_margin;
+    let pushable = |x: Vector2<f64>, d: Vector2<f64>| {
+        p.behind_penalty <= 1
+            || d.try_normalize(1e-12)
+                .is_none_or(|u| robot_fits(ws, obstacles, x - u * behind))
+    };
+    let (s0, g) = (cell_of(start), cell_of(goal));
     if at(g) == 0 {
         return None;
     }
+    // An object pushed closer to an obstacle than its clearance (it is there, so it fits) leaves
+    // by the nearest free cell within ESCAPE of it, straight away from what it is close to.
+    let s = if at(s0) > 0 {
+        s0
+    } else {
+        let reach = (ESCAPE / p.cell).ceil() as i32;
+        let mut best: Option<((i32, i32), i32)> = None;
+        for dj in -reach..=reach {
+            for di in -reach..=reach {
+                let n = (s0.0 + di, s0.1 + dj);
+                let d2 = di * di + dj * dj;
+                if n.0 < 0 || n.1 < 0 || n.0 >= nx || n.1 >= ny || d2 > reach * reach {
+                    continue;
+                }
+                let d = Vector2::new(f64::from(di), f64::from(dj));
+                let d2 = if pushable(centre(s0), d) { d2 } else { d2 * 16 };
+                if at(n) > 0 && best.is_none_or(|(_, b)| d2 < b) {
+                    best = Some((n, d2));
+                }
+            }
+        }
+        best?.0
+    };
     let (cells, _) = astar(
         &s,
         |&(i, j)| {
@@ -179,6 +219,12 @@ pub fn plan_object_path(
                 }
                 let f = at(n);
                 if f > 0 {
+                    let d = Vector2::new(f64::from(di), f64::from(dj));
+                    let f = if pushable(centre((i, j)), d) {
+                        f
+                    } else {
+                        f * p.behind_penalty
+                    };
                     v.push((n, w * f));
                 }
             }
@@ -191,7 +237,8 @@ pub fn plan_object_path(
         |&n| n == g,
     )?;
     let mut path: Vec<Vector2<f64>> = vec![start];
-    path.extend(cells.iter().skip(1).map(|&ij| centre(ij)));
+    let skip = if s == s0 { 1 } else { 0 };
+    path.extend(cells.iter().skip(skip).map(|&ij| centre(ij)));
     if let Some(last) = path.last_mut() {
         *last = goal;
     }
@@ -215,6 +262,54 @@ pub fn point_along(path: &[Vector2<f64>], spacing: f64) -> Option<Vector2<f64>> 
 /// its radius and 1 cm).
 pub fn robot_fits(ws: &Workspace, obstacles: &[Vec<[f64; 2]>], p: Vector2<f64>) -> bool {
     ws.reachable().contains(p) && clearance(p, obstacles) > ws.robot_radius + 0.01
+}
+
+/// Whether the robot's centre may move straight from `a` to `b` ([`robot_fits`] every 5 mm).
+pub fn segment_clear(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    a: Vector2<f64>,
+    b: Vector2<f64>,
+) -> bool {
+    let n = ((b - a).norm() / 0.005).ceil().max(1.0) as usize;
+    (0..=n).all(|k| robot_fits(ws, obstacles, a + (b - a) * (k as f64 / n as f64)))
+}
+
+/// A path for the robot's centre from `start` to `goal` around `obstacles` (the same A* as the
+/// object's, for a disc of the robot's radius on the table), shortened to the corners where
+/// the straight way is blocked; `None` when there is none.
+pub fn plan_robot_path(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    start: Vector2<f64>,
+    goal: Vector2<f64>,
+) -> Option<Vec<Vector2<f64>>> {
+    let disc = Workspace {
+        boundary: ws.reachable(),
+        object_radius: ws.robot_radius,
+        ..*ws
+    };
+    let op = ObstacleParams {
+        cell: 0.02,
+        object_margin: 0.015,
+        room_penalty: 1,
+        behind_penalty: 1,
+        ..ObstacleParams::default()
+    };
+    let path = plan_object_path(&disc, obstacles, start, goal, &op)?;
+    // Keep a way point only where the straight way from the last one kept is blocked.
+    let mut out = vec![start];
+    let mut i = 0;
+    while i + 1 < path.len() {
+        let from = out[out.len() - 1];
+        let mut j = i + 1;
+        while j + 1 < path.len() && segment_clear(ws, obstacles, from, path[j + 1]) {
+            j += 1;
+        }
+        out.push(path[j]);
+        i = j;
+    }
+    Some(out)
 }
 
 /// The scene's obstacles as polygons.
@@ -332,5 +427,51 @@ mod tests {
         assert_eq!(point_along(&path, 0.5), Some(Vector2::new(0.5, 0.0)));
         assert_eq!(point_along(&path, 1.5), Some(Vector2::new(1.0, 0.5)));
         assert_eq!(point_along(&path, 5.0), Some(Vector2::new(1.0, 1.0)));
+    }
+
+    /// An object left against the wall's face (closer than its clearance): the path leaves
+    /// along the wall, where the robot can stand behind it, not straight off the wall, where
+    /// it cannot; without the room-behind cost it goes straight off.
+    #[test]
+    fn an_object_against_a_wall_is_taken_along_it_where_the_robot_can_push() {
+        let ws = ws();
+        let wall = vec![rect(0.78, 0.55, 0.88, 1.2)];
+        let (s, g) = (Vector2::new(0.707, 0.857), Vector2::new(1.25, 0.6));
+        let behind = ws.object_radius + ws.robot_radius + ObstacleParams::default().room_margin;
+        let first_move = |p: &ObstacleParams| {
+            let path = plan_object_path(&ws, &wall, s, g, p).expect("a path");
+            assert_eq!(path[0], s);
+            let next = path
+                .iter()
+                .find(|q| (**q - s).norm() > 0.03)
+                .copied()
+                .unwrap();
+            (next - s).normalize()
+        };
+        let d = first_move(&ObstacleParams::default());
+        assert!(d.y < -0.7, "not along the wall: {d:?}");
+        let blind = ObstacleParams {
+            behind_penalty: 1,
+            ..ObstacleParams::default()
+        };
+        let d = first_move(&blind);
+        assert!(d.x < -0.9, "straight off the wall: {d:?}");
+        assert!(!robot_fits(&ws, &wall, s - d * behind), "{d:?}");
+    }
+
+    /// The robot's own path to the far side of a wall goes round its end, every leg clear.
+    #[test]
+    fn the_robot_transits_around_a_wall() {
+        let ws = ws();
+        let wall = vec![rect(0.78, 0.45, 0.88, 1.4)];
+        let (a, b) = (Vector2::new(0.5, 0.9), Vector2::new(1.2, 0.9));
+        assert!(!segment_clear(&ws, &wall, a, b));
+        let path = plan_robot_path(&ws, &wall, a, b).expect("a way round");
+        assert_eq!((path[0], *path.last().unwrap()), (a, b));
+        assert!(path.len() >= 3 && path.len() < 10, "{path:?}");
+        for w in path.windows(2) {
+            assert!(segment_clear(&ws, &wall, w[0], w[1]), "{w:?}");
+        }
+        assert!(path.iter().any(|q| q.y < 0.45), "{path:?}");
     }
 }
