@@ -7,7 +7,8 @@
 //!   5–15 cm; the irregular shape once with its marker near the middle, once near a corner) in
 //!   their test layout (Fig. 10): a bounded table, start positions `A`–`F` (the object starts
 //!   at `A`), one goal. `lau-obstacles`: the irregular object's layout with a wall between
-//!   start and goal (delivery among obstacles, §III-E).
+//!   start and goal (delivery among obstacles, §III-E); `lau-door`, `lau-zigzag` (and `-l`, the
+//!   L-shape): a wall with a 0.3 m door, two staggered walls.
 //! * `bsr-a` … `bsr-d` — Ben-Shahar & Rivlin's test cases A–D: boxes in rooms joined by doors
 //!   (A: two boxes to move to the other room; B: two boxes to exchange in a corridor; C: a
 //!   complex (U-shaped) movable through a door; D: an L-shaped movable in a cluttered room),
@@ -32,6 +33,10 @@ pub const NAMES: &[&str] = &[
     "lau-scissors",
     "lau-snake",
     "lau-obstacles",
+    "lau-door",
+    "lau-door-l",
+    "lau-zigzag",
+    "lau-zigzag-l",
     "bsr-a",
     "bsr-b",
     "bsr-c",
@@ -87,6 +92,14 @@ pub fn text(name: &str) -> Option<String> {
                 "pose = { x = 0.65, y = 0.95, theta = -1.5708 }",
             ) + &obstacle(7.8, 5.5, 8.8, 12.0)
         }
+        // Wall layouts the strategy never saw, for delivery among obstacles (§III-E): a wall
+        // across the table with a 0.3 m door (y 0.45–0.75 m) before the goal, and a zigzag of
+        // two staggered walls (one from the bottom edge up to y = 0.8 m, one from the top edge
+        // down to y = 0.4 m); each with the irregular object and the L-shape.
+        "lau-door" => lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &door(),
+        "lau-door-l" => lau(name, L_SHAPE, [-0.04, -0.035], 0.2, SUPPORT_UNIFORM) + &door(),
+        "lau-zigzag" => lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM) + &zigzag(),
+        "lau-zigzag-l" => lau(name, L_SHAPE, [-0.04, -0.035], 0.2, SUPPORT_UNIFORM) + &zigzag(),
         "bsr-a" => bsr_a(),
         "bsr-b" => bsr_b(),
         "bsr-c" => bsr_c(),
@@ -195,6 +208,17 @@ fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
 
 fn obstacle(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
     format!("\n[[obstacles]]\noutline = {}\n", rect(x0, y0, x1, y1))
+}
+
+/// A wall across the table at x 1.0–1.1 m with a 0.3 m door at y 0.45–0.75 m.
+fn door() -> String {
+    obstacle(10.0, 0.0, 11.0, 4.5) + &obstacle(10.0, 7.5, 11.0, 12.0)
+}
+
+/// Two staggered walls: x 0.6–0.7 m up from the bottom edge to y 0.8 m, x 1.0–1.1 m down from
+/// the top edge to y 0.4 m.
+fn zigzag() -> String {
+    obstacle(6.0, 0.0, 7.0, 8.0) + &obstacle(10.0, 4.0, 11.0, 12.0)
 }
 
 /// A box of `w` × `h` grid units centred at grid (cx, cy), with a goal at grid (gx, gy).
