@@ -1,6 +1,8 @@
 //! `pushbot mechanics`, `pushbot plan stable`, `pushbot bench stable`: stable pushing after
 //! Lynch & Mason (1996) — STABLE and controllability (§3), the push planner (§4).
 
+mod random_bench;
+
 use std::fmt::Write as _;
 
 use clap::Args;
@@ -58,6 +60,15 @@ pub struct BenchStableArgs {
     /// Only these presets (repeatable; default: all of them).
     #[arg(long = "preset", value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(PRESETS))]
     pub presets: Vec<String>,
+    /// Random scenes per pusher (`planner::stable::random_scene`, seeds `--seed` on); 0: none.
+    #[arg(long, default_value_t = 50)]
+    pub random: u64,
+    /// First seed of the random scenes.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Pushers of the random scenes (repeatable; default: diff-drive and car).
+    #[arg(long = "pusher", value_name = "KIND", value_parser = clap::builder::PossibleValuesParser::new(["diff-drive", "car", "omni", "arm"]))]
+    pub pushers: Vec<String>,
 }
 
 fn fmt_dir(v: &crate::mechanics::V3) -> serde_json::Value {
@@ -275,10 +286,11 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
             "paper_s": paper,
         }));
     }
+    let random = random_bench::bench_random(a)?;
     if g.json {
         println!(
             "{}",
-            json!({"bench": "stable", "repeat": a.repeat.max(1), "results": rows})
+            json!({"bench": "stable", "repeat": a.repeat.max(1), "results": rows, "random": random})
         );
     } else {
         println!(
@@ -297,6 +309,7 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
                 r["paper_s"].to_string()
             );
         }
+        random_bench::print_random(&random);
     }
     Ok(if all_found {
         Status::Success

@@ -10,6 +10,7 @@ use super::grid::{Cells, Grid};
 use super::open::{Fifo, Open, Pending, Queue};
 use super::steps::{Plan, Step, step_cost, summarise};
 use crate::planner::stable::collision::Frame;
+use crate::planner::stable::reach::unreachable;
 use crate::planner::stable::transit::{TransitPath, transit};
 use crate::planner::stable::{Pose, Problem};
 
@@ -76,6 +77,16 @@ fn step_ok(
         .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
 }
 
+/// The key a node of cost `g` and bound `h` takes in OPEN: `g + w·h` (weighted A*, §4.2.2's
+/// order when `w = 1`), at most `max_cost` (the bucket list's last).
+#[inline(always)]
+fn weighted(g: u32, h: u32, w: f64, max_cost: u32) -> u32 {
+    if w == 1.0 {
+        return g.saturating_add(h).min(max_cost);
+    }
+    (g as f64 + w * h as f64).round().min(max_cost as f64) as u32
+}
+
 /// `(sin, cos)` of the sum of two angles given as `(sin, cos)`.
 #[inline(always)]
 fn compose_sc((s, c): (f64, f64), (sd, cd): (f64, f64)) -> (f64, f64) {
@@ -118,9 +129,25 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     plan_checked(p, queue, Checks::Lazy)
 }
 
-/// Plan with the given OPEN list and collision-check timing ([`Checks`]).
+/// Plan with the given OPEN list and collision-check timing ([`Checks`]). A goal that
+/// [`unreachable`] proves cut off from the start is "no plan" without a search (no node
+/// expanded; `unreachable(p)` gives the reason).
 pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();
+    if unreachable(p).is_some() {
+        return Plan {
+            found: false,
+            cost: 0,
+            pushes: 0,
+            control_changes: 0,
+            contact_changes: 0,
+            nodes_expanded: 0,
+            plan_time_ms: t0.elapsed().as_secs_f64() * 1e3,
+            steps: vec![],
+            transits: vec![],
+            exact_goal: false,
+        };
+    }
     let heur = Heuristic::new(p);
     // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
     let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
@@ -141,8 +168,9 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
         },
     };
     let start_contact = p.start_contact.map_or(NONE, |c| c as u32);
+    let weight = p.params.weight.max(1.0);
     open.push(
-        heur.cost(heur.steps(&p.start)),
+        weighted(0, heur.cost(heur.steps(&p.start)), weight, max_cost),
         Pending {
             parent: NONE,
             contact: start_contact,
@@ -272,16 +300,17 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 if occupied.get(cells.cell(&q2, ci as u32)) <= cost {
                     continue;
                 }
-                let f = if heur_zero {
-                    cost
+                let h = if heur_zero {
+                    0
                 } else {
-                    cost.saturating_add(heur.cost(heur.quick(&q2)))
+                    heur.cost(heur.quick(&q2))
                 };
                 // The curve of control `k` through `q2` is the one through `q`.
-                let f = f.saturating_add(heur.turn_cost(&q, sc, ci, k));
-                if f > max_cost {
+                let h = h.saturating_add(heur.turn_cost(&q, sc, ci, k));
+                if cost.saturating_add(h) > max_cost {
                     continue;
                 }
+                let f = weighted(cost, h, weight, max_cost);
                 if !lazy && !step_ok(p, &q, (sc, fine), ci, k, &q2) {
                     continue;
                 }
@@ -324,7 +353,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize];
             plan.steps.push(Step {
                 contact: n.contact as usize,
-                edge: cm.edge,
+                edge: cm.label,
                 control: n.control as usize,
                 from: par.q,
                 to: n.q,

@@ -85,7 +85,7 @@ pub(in crate::planner::stable) fn push_steps(
     pushes: &[(V3, usize)],
     goal: &Pose,
 ) -> Vec<Step> {
-    let edge = p.contacts[ci].edge;
+    let edge = p.contacts[ci].label;
     let mut out = Vec::new();
     let mut at = *q;
     for (j, &(xi, control)) in pushes.iter().enumerate() {
