@@ -240,3 +240,35 @@ fn d8_walled_in_goal_is_refused_before_the_search() {
     assert!(pl.found);
     validate(&p, &pl);
 }
+
+/// D7: the goal is tested along each step, not only at its ends. With `a = 0, b = 1` (Fig.
+/// 17's kind of costs) and the pusher starting on edge 0, a goal 2.5 steps along one control's
+/// curve is reached by that one control: cost 0, the optimum. A search that tests only step
+/// ends steps over the small goal neighbourhood and pays control changes to land in it.
+#[test]
+fn d7_goal_between_step_ends_keeps_the_optimum() {
+    let text = scene(
+        1.0,
+        1.0,
+        "",
+        SLIDER,
+        [0.5, 0.3, 0.0],
+        [0.5, 0.6, 0.0],
+        "edges = [0, 3]\nstart_edge = 0\npusher = { kind = \"arm\" }\nplanner = { a = 0, b = 1, c = 10, step_frac = 0.2, grid_xy_frac = 0.5, grid_theta_deg = 2.0, max_cost = 40, max_nodes = 200000 }",
+    );
+    let mut p = problem(&text).unwrap();
+    let ci = p.start_contact.unwrap();
+    for k in 0..p.contacts[ci].steps.len() {
+        let xi = p.contacts[ci].steps[k];
+        p.goal = p.start.integrate(&(xi * 2.5));
+        p.params.goal_xy = 0.002;
+        p.params.goal_theta = 0.3f64.to_radians();
+        // The step ends before and after are outside the neighbourhood.
+        assert!(!p.in_goal(&p.start.integrate(&(xi * 2.0))));
+        assert!(!p.in_goal(&p.start.integrate(&(xi * 3.0))));
+        let pl = plan(&p);
+        assert!(pl.found, "control {k}: no plan");
+        validate(&p, &pl);
+        assert_eq!(pl.cost, 0, "control {k}: cost {} > the optimum 0", pl.cost);
+    }
+}

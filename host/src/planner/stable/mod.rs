@@ -330,6 +330,13 @@ impl Problem {
         }
     }
 
+    /// The longest path any slider vertex takes under the motion `xi` (the measure of a
+    /// step's length, [`step_twist`]).
+    pub fn slider_reach(&self, xi: &V3) -> f64 {
+        let unit = step_twist(&self.slider, xi, 1.0);
+        xi.norm() / unit.norm()
+    }
+
     /// Whether `q` is in the goal neighbourhood.
     pub fn in_goal(&self, q: &Pose) -> bool {
         (q.x - self.goal.x).abs() <= self.params.goal_xy
