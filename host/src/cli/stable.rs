@@ -207,6 +207,16 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display())))?;
     }
     let transit_length: f64 = p.transits.iter().map(|t| t.length).sum::<f64>() + 0.0;
+    // Why there is no plan, when it was decided before the search.
+    let no_plan = (!p.found && p.nodes_expanded == 0)
+        .then(|| crate::planner::stable::reach::unreachable(&problem))
+        .flatten();
+    if scene.outline_reversed && !g.json {
+        println!(
+            "note: the object's outline was clockwise and is stored counter-clockwise; edges \
+             are named as the scene writes them"
+        );
+    }
     if g.json {
         let out = json!({
             "scene": scene.name,
@@ -221,12 +231,14 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             "costs": {"a": problem.params.a, "b": problem.params.b, "c": problem.params.c},
             "transit_length": transit_length,
             "contacts": problem.contacts.iter().map(|c| json!({
-                "edge": c.edge,
+                "edge": c.label,
                 "contact": [[c.placement.contact.a.x, c.placement.contact.a.y], [c.placement.contact.b.x, c.placement.contact.b.y]],
                 "controls": c.usable.controls.iter().map(fmt_dir).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
             "path": p.steps,
             "transits": p.transits,
+            "no_plan_reason": no_plan.as_ref().map(|u| u.to_string()),
+            "edges_as_written": scene.outline_reversed,
         });
         println!("{out}");
     } else if p.found {
@@ -241,10 +253,13 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             transit_length
         );
     } else {
-        println!(
-            "no plan: {} nodes expanded in {:.1} ms",
-            p.nodes_expanded, p.plan_time_ms
-        );
+        match &no_plan {
+            Some(u) => println!("no plan: {u}"),
+            None => println!(
+                "no plan: {} nodes expanded in {:.1} ms",
+                p.nodes_expanded, p.plan_time_ms
+            ),
+        }
     }
     Ok(if p.found {
         Status::Success
