@@ -272,3 +272,47 @@ fn d7_goal_between_step_ends_keeps_the_optimum() {
         assert_eq!(pl.cost, 0, "control {k}: cost {} > the optimum 0", pl.cost);
     }
 }
+
+/// D6: on a concave slider a plate on a hull edge touches what of the slider lies on that
+/// edge's line, not just the edge: a U's two prong tops. The line contact is the true one,
+/// between the outermost points the plate covers (§3.3: a line contact is two point contacts
+/// at its ends). A plate too narrow to reach across the notch keeps to its own prong.
+#[test]
+fn d6_concave_slider_contact_is_the_true_contact() {
+    use pushbot::mechanics::{Slider, centroid};
+    use pushbot::planner::stable::pusher::{Pusher, PusherKind};
+    let u: Vec<V2> = [
+        [0.0, 0.0],
+        [0.2, 0.0],
+        [0.2, 0.15],
+        [0.14, 0.15],
+        [0.14, 0.1],
+        [0.06, 0.1],
+        [0.06, 0.15],
+        [0.0, 0.15],
+    ]
+    .iter()
+    .map(|p| V2::new(p[0], p[1]))
+    .collect();
+    let cof = centroid(&u);
+    let slider = Slider::new(&u, cof).unwrap();
+    // Edge 2: the right prong's top, (0.2, 0.15) → (0.14, 0.15).
+    let wide = Pusher::boxed(PusherKind::Omni, 0.3, 0.1, 0.05, Some(0.3));
+    let c = wide.placement(&slider, 2).unwrap().contact;
+    let xs = [c.a.x + cof.x, c.b.x + cof.x];
+    let (lo, hi) = (xs[0].min(xs[1]), xs[0].max(xs[1]));
+    assert!(
+        lo.abs() < 1e-9 && (hi - 0.2).abs() < 1e-9,
+        "contact from x = {lo} to {hi}, the prongs span 0 to 0.2"
+    );
+    assert!((c.a.y + cof.y - 0.15).abs() < 1e-9 && (c.b.y + cof.y - 0.15).abs() < 1e-9);
+    let narrow = Pusher::boxed(PusherKind::Omni, 0.04, 0.1, 0.05, Some(0.04));
+    let c = narrow.placement(&slider, 2).unwrap().contact;
+    for p in [c.a, c.b] {
+        let x = p.x + cof.x;
+        assert!(
+            (0.14 - 1e-9..=0.2 + 1e-9).contains(&x),
+            "narrow plate at x = {x}"
+        );
+    }
+}
