@@ -1,6 +1,8 @@
 //! `pushbot mechanics`, `pushbot plan stable`, `pushbot bench stable`: stable pushing after
 //! Lynch & Mason (1996) — STABLE and controllability (§3), the push planner (§4).
 
+mod random_bench;
+
 use std::fmt::Write as _;
 
 use clap::Args;
@@ -58,6 +60,15 @@ pub struct BenchStableArgs {
     /// Only these presets (repeatable; default: all of them).
     #[arg(long = "preset", value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(PRESETS))]
     pub presets: Vec<String>,
+    /// Random scenes per pusher (`planner::stable::random_scene`, seeds `--seed` on); 0: none.
+    #[arg(long, default_value_t = 50)]
+    pub random: u64,
+    /// First seed of the random scenes.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Pushers of the random scenes (repeatable; default: diff-drive and car).
+    #[arg(long = "pusher", value_name = "KIND", value_parser = clap::builder::PossibleValuesParser::new(["diff-drive", "car", "omni", "arm"]))]
+    pub pushers: Vec<String>,
 }
 
 fn fmt_dir(v: &crate::mechanics::V3) -> serde_json::Value {
@@ -196,6 +207,16 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display())))?;
     }
     let transit_length: f64 = p.transits.iter().map(|t| t.length).sum::<f64>() + 0.0;
+    // Why there is no plan, when it was decided before the search.
+    let no_plan = (!p.found && p.nodes_expanded == 0)
+        .then(|| crate::planner::stable::reach::unreachable(&problem))
+        .flatten();
+    if scene.outline_reversed && !g.json {
+        println!(
+            "note: the object's outline was clockwise and is stored counter-clockwise; edges \
+             are named as the scene writes them"
+        );
+    }
     if g.json {
         let out = json!({
             "scene": scene.name,
@@ -210,12 +231,14 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             "costs": {"a": problem.params.a, "b": problem.params.b, "c": problem.params.c},
             "transit_length": transit_length,
             "contacts": problem.contacts.iter().map(|c| json!({
-                "edge": c.edge,
+                "edge": c.label,
                 "contact": [[c.placement.contact.a.x, c.placement.contact.a.y], [c.placement.contact.b.x, c.placement.contact.b.y]],
                 "controls": c.usable.controls.iter().map(fmt_dir).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
             "path": p.steps,
             "transits": p.transits,
+            "no_plan_reason": no_plan.as_ref().map(|u| u.to_string()),
+            "edges_as_written": scene.outline_reversed,
         });
         println!("{out}");
     } else if p.found {
@@ -230,10 +253,13 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             transit_length
         );
     } else {
-        println!(
-            "no plan: {} nodes expanded in {:.1} ms",
-            p.nodes_expanded, p.plan_time_ms
-        );
+        match &no_plan {
+            Some(u) => println!("no plan: {u}"),
+            None => println!(
+                "no plan: {} nodes expanded in {:.1} ms",
+                p.nodes_expanded, p.plan_time_ms
+            ),
+        }
     }
     Ok(if p.found {
         Status::Success
@@ -275,10 +301,11 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
             "paper_s": paper,
         }));
     }
+    let random = random_bench::bench_random(a)?;
     if g.json {
         println!(
             "{}",
-            json!({"bench": "stable", "repeat": a.repeat.max(1), "results": rows})
+            json!({"bench": "stable", "repeat": a.repeat.max(1), "results": rows, "random": random})
         );
     } else {
         println!(
@@ -297,6 +324,7 @@ pub fn run_bench(g: &Global, a: &BenchStableArgs) -> CliResult {
                 r["paper_s"].to_string()
             );
         }
+        random_bench::print_random(&random);
     }
     Ok(if all_found {
         Status::Success

@@ -297,16 +297,32 @@ pub fn theorem7(contacts: &[LineContact], mu: f64) -> bool {
     if arcs.is_empty() {
         return false;
     }
-    // Open arcs positively span the plane iff the uncovered part of the circle has no piece of
-    // length ≥ π. Sample the arcs' interiors finely enough and use the angle gap test.
-    let mut angles = Vec::new();
-    for (lo, hi) in &arcs {
-        let k = 64;
-        for i in 1..k {
-            angles.push((lo + (hi - lo) * i as f64 / k as f64).rem_euclid(2.0 * PI));
-        }
+    open_arcs_span_circle(&arcs)
+}
+
+/// Whether the union of the open arcs `(lo, hi)` (radians, `0 < hi − lo < 2π`) positively
+/// spans the plane: exactly when no closed half-plane holds it, i.e. when every gap the arcs
+/// leave on the circle is shorter than π. Decided exactly on the arcs' end points (a sweep
+/// around the circle from the first arc's start), not on samples of their interiors.
+pub fn open_arcs_span_circle(arcs: &[(f64, f64)]) -> bool {
+    let mut a: Vec<(f64, f64)> = arcs
+        .iter()
+        .filter(|(lo, hi)| hi > lo)
+        .map(|&(lo, hi)| (lo.rem_euclid(2.0 * PI), (hi - lo).min(2.0 * PI)))
+        .collect();
+    if a.is_empty() {
+        return false;
     }
-    angles_span_circle(angles)
+    a.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let first = a[0].0;
+    let mut end = first + a[0].1;
+    let mut max_gap: f64 = 0.0;
+    for &(lo, len) in &a[1..] {
+        max_gap = max_gap.max(lo - end);
+        end = end.max(lo + len);
+    }
+    max_gap = max_gap.max(first + 2.0 * PI - end);
+    max_gap < PI
 }
 
 #[cfg(test)]

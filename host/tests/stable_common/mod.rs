@@ -54,7 +54,7 @@ pub fn validate(p: &Problem, plan: &Plan) {
     let mut cost = 0u32;
     let (mut cc, mut ctl) = (0usize, 0usize);
     if let Some(sc) = p.start_contact {
-        prev = Some((p.contacts[sc].edge, V3::zeros()));
+        prev = Some((p.contacts[sc].label, V3::zeros()));
     }
     let slider_convex = hull(&p.slider.vertices);
     for (i, s) in plan.steps.iter().enumerate() {
@@ -68,7 +68,7 @@ pub fn validate(p: &Problem, plan: &Plan) {
         let xi = s.from.twist_to(&s.to);
         let dir = xi.normalize();
         let cm = &p.contacts[s.contact];
-        assert_eq!(cm.edge, s.edge);
+        assert_eq!(cm.label, s.edge);
         let st = stable(&p.slider, &cm.placement.contact, p.mu).unwrap();
         assert!(
             st.constraints.iter().all(|a| a.dot(&dir) >= -1e-6),

@@ -11,7 +11,8 @@
 
 use parry2d_f64::math::{Pose as PPose, Vector as PVec};
 use parry2d_f64::query;
-use parry2d_f64::shape::ConvexPolygon;
+use parry2d_f64::shape::{ConvexPolygon, TriMesh};
+use parry2d_f64::transformation::hertel_mehlhorn;
 
 use super::Pose;
 use crate::mechanics::{V2, V3, convex_hull};
@@ -45,6 +46,39 @@ pub fn convex(points: &[V2]) -> Option<ConvexPolygon> {
 }
 
 impl Obstacle {
+    /// A simple polygon (either sense, convex or not) as exact convex obstacles: itself when
+    /// convex, else its convex parts (triangulated by ear clipping and merged by
+    /// Hertel–Mehlhorn, parry's `hertel_mehlhorn`), never its hull. `None` if degenerate or
+    /// not simple.
+    pub fn parts(points: &[V2]) -> Option<Vec<Obstacle>> {
+        let mut pts = points.to_vec();
+        if crate::mechanics::signed_area(&pts) < 0.0 {
+            pts.reverse();
+        }
+        let n = pts.len();
+        let convex = (0..n).all(|i| {
+            let (a, b, c) = (pts[i], pts[(i + 1) % n], pts[(i + 2) % n]);
+            let (e, f) = (b - a, c - b);
+            e.x * f.y - e.y * f.x >= -1e-12 * e.norm() * f.norm()
+        });
+        if convex {
+            return Some(vec![Obstacle::new(&pts)?]);
+        }
+        let mesh = TriMesh::from_polygon(pts.iter().map(|p| PVec::new(p.x, p.y)).collect())?;
+        let parts: Vec<Obstacle> = hertel_mehlhorn(mesh.vertices(), mesh.indices())
+            .iter()
+            .filter_map(|part| {
+                Obstacle::new(&part.iter().map(|q| V2::new(q.x, q.y)).collect::<Vec<_>>())
+            })
+            .collect();
+        (!parts.is_empty()).then_some(parts)
+    }
+
+    /// The parry shape.
+    pub fn shape(&self) -> &ConvexPolygon {
+        &self.shape
+    }
+
     /// An obstacle from the convex hull of `points`; `None` if degenerate.
     pub fn new(points: &[V2]) -> Option<Self> {
         let vertices = convex_hull(points);

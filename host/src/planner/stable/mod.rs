@@ -13,6 +13,8 @@ pub mod collision;
 pub mod exact;
 pub mod presets;
 pub mod pusher;
+pub mod random_scene;
+pub mod reach;
 pub mod robot;
 pub mod search;
 pub mod svg;
@@ -155,14 +157,22 @@ pub struct Params {
     pub fine_radius: f64,
     /// Refinement factor (≥ 1) for step and grid cells near the goal.
     pub fine_factor: f64,
+    /// Weight `w ≥ 1` of the A* bound in OPEN's order (`g + w·h`): 1 is A* (the plan the
+    /// search would find with an exact order); above 1 the search expands fewer
+    /// configurations and may return a plan costing up to `w` times more.
+    pub weight: f64,
 }
 
 /// One pushing contact the planner may use: an edge, the pusher placed on it, its usable pushes
 /// and the body `PS` (slider + pusher) it moves.
 #[derive(Debug, Clone)]
 pub struct ContactModel {
-    /// Slider edge index.
+    /// Slider edge index (edges of the counter-clockwise [`Slider`]).
     pub edge: usize,
+    /// The edge's number as the scene gives it: `edge`, unless the outline was given clockwise
+    /// and stored counter-clockwise (then the scene's edge `i` is `edge` `n − 1 − i`). Plans
+    /// and messages name edges by it.
+    pub label: usize,
     /// The pusher's placement on the edge.
     pub placement: Placement,
     /// Stable ∩ pusher-feasible pushes.
@@ -236,7 +246,10 @@ impl Problem {
                 .iter()
                 .map(|p| placement.to_slider(*p))
                 .collect();
-            let mut parts = vec![slider.vertices.clone()];
+            // The slider exactly: a concave one as its convex parts, not its hull.
+            let mut parts: Vec<Vec<V2>> = collision::Obstacle::parts(&slider.vertices)
+                .map(|ps| ps.into_iter().map(|o| o.vertices).collect())
+                .unwrap_or_else(|| vec![slider.vertices.clone()]);
             if !footprint.is_empty() {
                 parts.push(footprint.clone());
             }
@@ -262,6 +275,7 @@ impl Problem {
             let fine_delta_sc = fine_deltas.iter().map(|d| d.theta.sin_cos()).collect();
             contacts.push(ContactModel {
                 edge: e,
+                label: e,
                 placement,
                 usable,
                 body,
@@ -314,6 +328,13 @@ impl Problem {
         } else {
             (&cm.steps, &cm.swept, &cm.deltas)
         }
+    }
+
+    /// The longest path any slider vertex takes under the motion `xi` (the measure of a
+    /// step's length, [`step_twist`]).
+    pub fn slider_reach(&self, xi: &V3) -> f64 {
+        let unit = step_twist(&self.slider, xi, 1.0);
+        xi.norm() / unit.norm()
     }
 
     /// Whether `q` is in the goal neighbourhood.

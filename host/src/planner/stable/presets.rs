@@ -26,7 +26,7 @@ pub struct Scene {
     pub table: [f64; 2],
     /// Pusher–slider friction coefficient.
     pub mu: f64,
-    /// Convex obstacles (world frame).
+    /// Obstacles (world frame), convex or not.
     pub obstacles: Vec<ObstacleSpec>,
     /// Objects; the task's object is pushed, the others are static obstacles at `pose`.
     pub objects: Vec<ObjectSpec>,
@@ -36,12 +36,17 @@ pub struct Scene {
     pub pusher: PusherSpec,
     /// Planner settings.
     pub planner: PlannerSpec,
+    /// Whether the pushed object's outline was given clockwise and stored counter-clockwise
+    /// (the world crate's `normalise_ccw`): its edge `i` as given is edge `n − 1 − i` of the
+    /// stored outline. `task.edges` and `task.start_edge` are stored-outline numbers; plans
+    /// name edges as given ([`super::ContactModel::label`]).
+    pub outline_reversed: bool,
 }
 
 /// An obstacle.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ObstacleSpec {
-    /// Vertices of a convex polygon.
+    /// Vertices of a simple polygon, counter-clockwise.
     pub polygon: Vec<[f64; 2]>,
 }
 
@@ -162,8 +167,15 @@ pub fn scene_from_toml(text: &str, file: &str) -> anyhow::Result<Scene> {
              Scenes section)"
         );
     }
-    let shared = pushbot_world::Scene::from_toml(text, file).map_err(|e| anyhow!("{e}"))?;
-    from_shared(&shared).with_context(|| format!("scene file {file}"))
+    let (shared, notes) =
+        pushbot_world::Scene::from_toml_noted(text, file).map_err(|e| anyhow!("{e}"))?;
+    let mut s = from_shared(&shared).with_context(|| format!("scene file {file}"))?;
+    let object = shared.objects.iter().position(|o| o.id == s.task.object);
+    s.outline_reversed = object.is_some_and(|i| {
+        let field = format!("objects[{i}].outline");
+        notes.iter().any(|n| n.field == field)
+    });
+    Ok(s)
 }
 
 /// Load a scene by preset name or from a file in the shared scene format.
@@ -182,7 +194,7 @@ pub fn load_scene(name_or_path: &str) -> anyhow::Result<Scene> {
 }
 
 /// A stable-pushing scene from a scene in the shared format (`pushbot_world::Scene`) with a
-/// `[stable]` section: the table, the obstacles (as their convex hulls), the pushed object
+/// `[stable]` section: the table, the obstacles (exact: a non-convex one as its convex parts), the pushed object
 /// (its centre of friction from its support distribution, its start from its pose, its goal
 /// from the scene's goal for it, `μ` from its `pusher_friction`), the other objects as static
 /// obstacles, and the pusher and planner settings of `[stable]`; a differential drive takes
@@ -230,6 +242,18 @@ pub fn from_shared(sc: &pushbot_world::Scene) -> anyhow::Result<Scene> {
     let plate = sc.robot.front_plate;
     let p = &st.pusher;
     let diff = p.kind == "diff-drive";
+    if diff && plate.is_none() && p.plate_width.is_none() {
+        // Stable pushing (§2–3) needs the pusher to hold the edge in a line contact. A round
+        // bumper touches a flat edge at one point, and that point slides along the bumper's
+        // arc as the robot turns against the slider: not a line contact, and not the plate
+        // this planner would otherwise assume.
+        bail!(
+            "stable.pusher: a diff-drive pushes with the robot, and this robot has a round bumper \
+             (no [robot] front_plate): a round bumper touches an edge at one point that moves on \
+             its arc, which stable pushing's line contact does not model; give the robot a \
+             front_plate = {{ width, offset }} or the pusher a plate_width"
+        );
+    }
     let pl = &st.planner;
     Ok(Scene {
         name: sc.name.clone(),
@@ -289,6 +313,7 @@ pub fn from_shared(sc: &pushbot_world::Scene) -> anyhow::Result<Scene> {
             fine_radius_frac: pl.fine_radius_frac,
             fine_factor: pl.fine_factor,
         },
+        outline_reversed: false,
     })
     .and_then(|s| {
         validate(&s)?;
@@ -314,7 +339,7 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
         if o.polygon.len() < 3 || !o.polygon.iter().all(|p| finite(p)) {
             bail!("obstacles[{i}].outline: needs at least 3 finite points");
         }
-        if Obstacle::new(&pts(&o.polygon)).is_none() {
+        if Obstacle::parts(&pts(&o.polygon)).is_none() {
             bail!("obstacles[{i}].outline: degenerate polygon");
         }
     }
@@ -335,7 +360,7 @@ fn validate(s: &Scene) -> anyhow::Result<()> {
     if let Some(e) = s.task.start_edge
         && !s.task.edges.contains(&e)
     {
-        bail!("stable.start_edge: edge {e} is not in stable.edges");
+        bail!("stable.start_edge: the start edge is not in stable.edges");
     }
     if !(s.task.goal_xy_frac > 0.0 && s.task.goal_theta_deg > 0.0) {
         bail!("stable.goal_xy_frac and stable.goal_theta_deg: must be > 0");
@@ -441,9 +466,34 @@ impl Scene {
         }
     }
 
+    /// The pushed object's edge `e` (stored outline) as the scene numbers it.
+    pub fn edge_label(&self, e: usize) -> anyhow::Result<usize> {
+        let n = self
+            .objects
+            .iter()
+            .find(|o| o.id == self.task.object)
+            .map_or(0, |o| o.polygon.len());
+        Ok(if self.outline_reversed && e < n {
+            pushbot_world::polygon::reversed_edge(e, n)
+        } else {
+            e
+        })
+    }
+
     /// Build the planning problem.
     pub fn problem(&self, costs: CostOverride) -> anyhow::Result<Problem> {
         let slider = self.slider(&self.task.object)?;
+        for (i, &e) in self.task.edges.iter().enumerate() {
+            let label = self.edge_label(e)?;
+            match slider.is_hull_edge(e) {
+                Err(err) => bail!("stable.edges[{i}]: edge {label}: {err}"),
+                Ok(false) => bail!(
+                    "stable.edges[{i}]: edge {label} is not on the convex hull of the object: a \
+                     flat pusher cannot lie on it"
+                ),
+                Ok(true) => {}
+            }
+        }
         let len = slider.length();
         let pl = &self.planner;
         let step = pl.step_frac.unwrap_or(0.2) * len;
@@ -469,11 +519,13 @@ impl Scene {
             max_nodes: pl.max_nodes.unwrap_or(200_000),
             fine_radius: pl.fine_radius_frac.unwrap_or(0.0) * len,
             fine_factor: pl.fine_factor.unwrap_or(1.0).max(1.0),
+            weight: 1.0,
         };
         let mut obstacles = Vec::new();
-        for o in &self.obstacles {
-            obstacles.push(
-                Obstacle::new(&pts(&o.polygon)).ok_or_else(|| anyhow!("degenerate obstacle"))?,
+        for (i, o) in self.obstacles.iter().enumerate() {
+            obstacles.extend(
+                Obstacle::parts(&pts(&o.polygon))
+                    .ok_or_else(|| anyhow!("obstacles[{i}]: degenerate or not simple"))?,
             );
         }
         for o in &self.objects {
@@ -484,8 +536,8 @@ impl Scene {
                 let s = self.slider(&o.id)?;
                 let q = Pose::new(pose[0], pose[1], pose[2].to_radians());
                 let w: Vec<V2> = s.vertices.iter().map(|v| q.apply(*v)).collect();
-                obstacles.push(
-                    Obstacle::new(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?,
+                obstacles.extend(
+                    Obstacle::parts(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?,
                 );
             }
         }
@@ -507,11 +559,14 @@ impl Scene {
         problem.start_contact = t
             .start_edge
             .and_then(|e| t.edges.iter().position(|&x| x == e));
+        for cm in problem.contacts.iter_mut() {
+            cm.label = self.edge_label(cm.edge)?;
+        }
         for (i, cm) in problem.contacts.iter().enumerate() {
             if cm.usable.controls.is_empty() {
                 bail!(
                     "stable.edges[{i}]: edge {} has no usable stable push for this pusher",
-                    cm.edge
+                    cm.label
                 );
             }
         }

@@ -95,8 +95,11 @@ impl Pusher {
     }
 
     /// Where the pusher sits on edge `edge`: the contact-frame x of its centre line (the foot of
-    /// the perpendicular from the centre of friction, clamped into the edge), and the line
-    /// contact its plate makes there.
+    /// the perpendicular from the centre of friction, clamped into what of the slider lies on
+    /// the edge's line), and the line contact its plate makes there: the true contact, from the
+    /// outermost to the outermost point of the slider the plate covers on that line (for a
+    /// concave slider this may span several collinear edges and the gaps between them, as a
+    /// line contact is equivalent to two point contacts at its ends, §3.3).
     pub fn placement(&self, slider: &Slider, edge: usize) -> Result<Placement, MechanicsError> {
         let full = LineContact::full_edge(slider, edge)?;
         let (xa, xb) = (
@@ -104,10 +107,45 @@ impl Pusher {
             full.to_contact_frame(full.b).x,
         );
         let y0 = full.to_contact_frame(full.a).y;
-        let offset = 0.0f64.clamp(xa.min(xb), xa.max(xb));
-        let (lo, hi) = match self.plate_width {
-            Some(w) => ((offset - w / 2.0).max(xa), (offset + w / 2.0).min(xb)),
-            None => (xa, xb),
+        // What of the slider lies on the edge's line: the edge itself, and for a concave slider
+        // every other edge on the same hull line (a U's two prongs). A plate on the edge
+        // touches all of them that it covers; the true contact runs between the outermost.
+        let n_v = slider.vertices.len();
+        let tol = 1e-9 * (1.0 + slider.radius());
+        let on_line: Vec<(f64, f64)> = (0..n_v)
+            .filter_map(|j| {
+                let (p, q) = (
+                    full.to_contact_frame(slider.vertices[j]),
+                    full.to_contact_frame(slider.vertices[(j + 1) % n_v]),
+                );
+                ((p.y - y0).abs() <= tol && (q.y - y0).abs() <= tol)
+                    .then_some((p.x.min(q.x), p.x.max(q.x)))
+            })
+            .collect();
+        let touched = |lo: f64, hi: f64| {
+            on_line.iter().filter(|(a, b)| *a <= hi && *b >= lo).fold(
+                None,
+                |acc: Option<(f64, f64)>, (a, b)| {
+                    let (a, b) = (a.max(lo), b.min(hi));
+                    Some(acc.map_or((a, b), |(c, d)| (c.min(a), d.max(b))))
+                },
+            )
+        };
+        let span_lo = on_line.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
+        let span_hi = on_line
+            .iter()
+            .map(|s| s.1)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let plate = |offset: f64| match self.plate_width {
+            Some(w) => touched(offset - w / 2.0, offset + w / 2.0),
+            None => touched(f64::NEG_INFINITY, f64::INFINITY),
+        };
+        // Centred under the centre of friction where the plate touches there, else on the edge.
+        let centred = 0.0f64.clamp(span_lo.min(span_hi), span_hi.max(span_lo));
+        let on_edge = 0.0f64.clamp(xa.min(xb), xa.max(xb));
+        let (offset, (lo, hi)) = match plate(centred) {
+            Some(c) if c.1 > c.0 => (centred, c),
+            _ => (on_edge, plate(on_edge).unwrap_or((xa.min(xb), xa.max(xb)))),
         };
         let t = full.tangent();
         let n = full.normal();

@@ -5,7 +5,7 @@
 
 use anyhow::{Context, Result, anyhow, bail};
 
-use super::presets::{CostOverride, CostSpec, Scene as StableScene, load_scene};
+use super::presets::{CostOverride, CostSpec, PRESETS, Scene as StableScene, load_scene};
 use super::{Plan, Problem};
 use crate::mechanics::{V2, V3};
 
@@ -70,6 +70,48 @@ pub fn robot_problem_edges(
         .problem(CostOverride::default())
         .with_context(|| format!("robot problem {name} on edges {edges:?}"))?;
     Ok((s, p))
+}
+
+/// The preset (or scene file) `name` for the plated robot, honouring its `[stable]` section:
+/// its edges, start edge, costs (`c` included), step, grid and goal tolerances are kept. A
+/// differential-drive pusher is the robot itself and is kept as the scene gives it (its plate
+/// from `[robot] front_plate` or the pusher's `plate_width`); any other pusher (the presets'
+/// arm, omnidirectional robot or car) is replaced by the robot with its plate
+/// ([`PLATE_WIDTH`], [`PLATE_OFFSET`], or the scene's `front_plate`), on a grid of half a step
+/// in x, y ([`ROBOT_GRID_XY_FRAC`]) unless the scene sets one. What `pushbot demo`'s stable
+/// stage plans with.
+pub fn robot_problem_scene(name: &str) -> Result<(StableScene, Problem)> {
+    let mut s = load_scene(name)?;
+    if s.pusher.kind != "diff-drive" {
+        let (width, offset) = match robot_plate(name) {
+            Some(p) => p,
+            None => (PLATE_WIDTH, PLATE_OFFSET),
+        };
+        s.pusher.kind = "diff-drive".into();
+        s.pusher.width = Some(width);
+        s.pusher.depth = Some(offset + 0.04);
+        s.pusher.axle_offset = Some(offset);
+        s.pusher.plate_width = Some(width);
+        s.pusher.min_turning_radius = None;
+        if s.planner.grid_xy_frac.is_none() || PRESETS.contains(&name) {
+            s.planner.grid_xy_frac = Some(ROBOT_GRID_XY_FRAC);
+        }
+    }
+    let p = s
+        .problem(CostOverride::default())
+        .with_context(|| format!("robot problem {name} (its [stable] section)"))?;
+    Ok((s, p))
+}
+
+/// The `[robot] front_plate` (width, offset) of the scene `name`, if it has one.
+fn robot_plate(name: &str) -> Option<(f64, f64)> {
+    let sc = if PRESETS.contains(&name) {
+        pushbot_world::Scene::preset(name).ok()?
+    } else {
+        let text = std::fs::read_to_string(name).ok()?;
+        pushbot_world::Scene::from_toml(&text, name).ok()?
+    };
+    sc.robot.front_plate.map(|f| (f.width, f.offset))
 }
 
 /// The robot's axle centre and heading in the slider frame for contact `ci`.

@@ -85,7 +85,13 @@ pub fn grow(poly: &[V2], r: f64) -> Vec<V2> {
 }
 
 /// Shortest path for a disk of radius `r` from `s` to `g` among convex obstacles inside a
-/// `w × h` table (visibility graph + Dijkstra). Returns the way points.
+/// `w × h` table (visibility graph, A* with the straight-line distance). Returns the way points.
+///
+/// The obstacles are added as the path meets them: the shortest path among a subset of the
+/// obstacles is found, and if it also misses all the others it is a shortest path among all of
+/// them; else the obstacles it meets join the subset and the search is repeated. If there is
+/// no path among a subset there is none among all. Obstacles are grown only when their box
+/// comes within reach.
 pub fn disk_path(
     s: V2,
     g: V2,
@@ -93,18 +99,72 @@ pub fn disk_path(
     table: (f64, f64),
     obstacles: &[Vec<V2>],
 ) -> Option<Vec<V2>> {
-    let grown: Vec<Vec<V2>> = obstacles.iter().map(|o| grow(o, r)).collect();
     let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
-    let free_pt = |p: V2| in_table(p) && !grown.iter().any(|o| inside_convex(p, o));
-    if !free_pt(s) || !free_pt(g) {
-        return None;
+    // Each obstacle's box grown by more than the octagon's circumradius.
+    let reach = r / (std::f64::consts::PI / 8.0).cos() + 1e-9;
+    let boxes: Vec<(V2, V2)> = obstacles
+        .iter()
+        .map(|o| {
+            let (mut a, mut b) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+            for p in o {
+                a = a.inf(p);
+                b = b.sup(p);
+            }
+            (a - V2::repeat(reach), b + V2::repeat(reach))
+        })
+        .collect();
+    let mut grown: Vec<Option<Vec<V2>>> = vec![None; obstacles.len()];
+    let seg_box = |a: V2, b: V2, (lo, hi): (V2, V2)| {
+        a.x.max(b.x) >= lo.x && a.x.min(b.x) <= hi.x && a.y.max(b.y) >= lo.y && a.y.min(b.y) <= hi.y
+    };
+    for p in [s, g] {
+        if !in_table(p) {
+            return None;
+        }
+        for (i, bx) in boxes.iter().enumerate() {
+            if seg_box(p, p, *bx)
+                && inside_convex(p, grown[i].get_or_insert_with(|| grow(&obstacles[i], r)))
+            {
+                return None;
+            }
+        }
     }
+    let mut subset: Vec<usize> = Vec::new();
+    loop {
+        let refs: Vec<&[V2]> = subset.iter().filter_map(|&i| grown[i].as_deref()).collect();
+        let path = visibility_path(s, g, &refs, &in_table)?;
+        let mut hit = Vec::new();
+        for (i, bx) in boxes.iter().enumerate() {
+            if subset.contains(&i) || !path.windows(2).any(|w| seg_box(w[0], w[1], *bx)) {
+                continue;
+            }
+            let o = grown[i].get_or_insert_with(|| grow(&obstacles[i], r));
+            if path.windows(2).any(|w| segment_hits_convex(w[0], w[1], o)) {
+                hit.push(i);
+            }
+        }
+        if hit.is_empty() {
+            return Some(path);
+        }
+        subset.extend(hit);
+    }
+}
+
+/// The shortest path from `s` to `g` (both free) in the visibility graph of the grown convex
+/// obstacles `grown` (their vertices pushed out by 1 µm, those inside the table and no
+/// obstacle), by A* on the straight-line distance to `g`.
+fn visibility_path(
+    s: V2,
+    g: V2,
+    grown: &[&[V2]],
+    in_table: &dyn Fn(V2) -> bool,
+) -> Option<Vec<V2>> {
     let mut nodes = vec![s, g];
-    for o in &grown {
+    for o in grown {
         let c = o.iter().sum::<V2>() / o.len() as f64;
-        for v in o {
+        for v in o.iter() {
             let p = v + (v - c).normalize() * 1e-6;
-            if free_pt(p) {
+            if in_table(p) && !grown.iter().any(|q| inside_convex(p, q)) {
                 nodes.push(p);
             }
         }
@@ -115,8 +175,9 @@ pub fn disk_path(
     let mut prev = vec![usize::MAX; n];
     let mut done = vec![false; n];
     dist[0] = 0.0;
+    let key = |d: f64, v: usize| ((d + (nodes[v] - g).norm()) * 1e9) as u64;
     let mut heap = BinaryHeap::new();
-    heap.push(std::cmp::Reverse((0u64, 0usize)));
+    heap.push(std::cmp::Reverse((key(0.0, 0), 0usize)));
     while let Some(std::cmp::Reverse((_, u))) = heap.pop() {
         if done[u] {
             continue;
@@ -133,7 +194,7 @@ pub fn disk_path(
             if d < dist[v] && visible(nodes[u], nodes[v]) {
                 dist[v] = d;
                 prev[v] = u;
-                heap.push(std::cmp::Reverse(((d * 1e9) as u64, v)));
+                heap.push(std::cmp::Reverse((key(d, v), v)));
             }
         }
     }

@@ -6,12 +6,15 @@ use std::collections::{BinaryHeap, HashMap};
 use std::time::Instant;
 
 use super::bound::Heuristic;
+use super::crossing::goal_finish;
+use super::finish::pushes_in_steps;
 use super::grid::{Cells, Grid};
-use super::open::{Fifo, Open, Pending, Queue};
+use super::open::{Fifo, Finish, Open, Pending, Queue};
 use super::steps::{Plan, Step, step_cost, summarise};
 use crate::planner::stable::collision::Frame;
+use crate::planner::stable::reach::unreachable;
 use crate::planner::stable::transit::{TransitPath, transit};
-use crate::planner::stable::{Pose, Problem};
+use crate::planner::stable::{Pose, Problem, step_twist};
 
 const NONE: u32 = u32::MAX;
 
@@ -36,6 +39,8 @@ struct Expanded {
     sc: (f64, f64),
     /// Whether `q` is in the refined region (§4.5): its children take the fine steps.
     fine: bool,
+    /// The part of its step the node took: 1, or less for an exact finish.
+    frac: f64,
     contact: u32,
     control: u32,
     parent: u32,
@@ -74,6 +79,26 @@ fn step_ok(
     let sc2 = compose_sc(sc, (sd, cd));
     cm.body
         .step_free_swept_in(&p.world, from, &frame, xi, swept, to, sc2)
+}
+
+/// The key a node of cost `g` and bound `h` takes in OPEN: `g + w·h` (weighted A*, §4.2.2's
+/// order when `w = 1`), at most `max_cost` (the bucket list's last).
+#[inline(always)]
+fn weighted(g: u32, h: u32, w: f64, max_cost: u32) -> u32 {
+    if w == 1.0 {
+        return g.saturating_add(h).min(max_cost);
+    }
+    (g as f64 + w * h as f64).round().min(max_cost as f64) as u32
+}
+
+/// Whether the step `xi` from `q` to `q2` may pass through the goal neighbourhood: both ends
+/// within the neighbourhood's half-diagonal plus the length of the path the centre of friction
+/// takes (`|(ξx, ξy)|`) of the goal (a cheap filter before [`goal_crossing`]).
+#[inline(always)]
+fn near_goal_of(p: &Problem, q: &Pose, q2: &Pose, xi: &crate::mechanics::V3) -> bool {
+    let r = p.params.goal_xy * std::f64::consts::SQRT_2 + xi.x.hypot(xi.y);
+    let d = |a: &Pose| (a.x - p.goal.x).hypot(a.y - p.goal.y);
+    d(q) <= r && d(q2) <= r
 }
 
 /// `(sin, cos)` of the sum of two angles given as `(sin, cos)`.
@@ -118,9 +143,25 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
     plan_checked(p, queue, Checks::Lazy)
 }
 
-/// Plan with the given OPEN list and collision-check timing ([`Checks`]).
+/// Plan with the given OPEN list and collision-check timing ([`Checks`]). A goal that
+/// [`unreachable`] proves cut off from the start is "no plan" without a search (no node
+/// expanded; `unreachable(p)` gives the reason).
 pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();
+    if unreachable(p).is_some() {
+        return Plan {
+            found: false,
+            cost: 0,
+            pushes: 0,
+            control_changes: 0,
+            contact_changes: 0,
+            nodes_expanded: 0,
+            plan_time_ms: t0.elapsed().as_secs_f64() * 1e3,
+            steps: vec![],
+            transits: vec![],
+            exact_goal: false,
+        };
+    }
     let heur = Heuristic::new(p);
     // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
     let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
@@ -141,13 +182,15 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
         },
     };
     let start_contact = p.start_contact.map_or(NONE, |c| c as u32);
+    let weight = p.params.weight.max(1.0);
     open.push(
-        heur.cost(heur.steps(&p.start)),
+        weighted(0, heur.cost(heur.steps(&p.start)), weight, max_cost),
         Pending {
             parent: NONE,
             contact: start_contact,
             control: NONE,
             cost: 0,
+            finish: Finish::No,
         },
     );
     let heur_zero = heur.cost(u32::MAX) == 0;
@@ -158,6 +201,88 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let mut goal_node = None;
     // The start must be free for some contact's body; each step checks its own body.
     while let Some(n) = open.pop() {
+        if n.finish == Finish::Push {
+            // §4.5's finish: one usable push from the parent onto the goal, free all along.
+            let par = closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let xi = par.q.twist_to(&p.goal);
+            if !cm.usable.set.contains(&xi) || !cm.body.step_free(&p.world, &par.q, &xi) {
+                continue;
+            }
+            let mut transit_id = NONE;
+            if mobile && par.contact != NONE && par.contact != n.contact {
+                match transit_of(
+                    p,
+                    &closed,
+                    &mut transit_cache,
+                    &mut transits,
+                    n.parent,
+                    n.contact,
+                ) {
+                    Some(ti) => transit_id = ti,
+                    None => continue,
+                }
+            }
+            closed.push(Expanded {
+                q: p.goal,
+                sc: p.goal.theta.sin_cos(),
+                fine: par.fine,
+                frac: 1.0,
+                contact: n.contact,
+                control: NONE,
+                parent: n.parent,
+                cost: n.cost,
+                transit: transit_id,
+            });
+            goal_node = Some((closed.len() - 1) as u32);
+            break;
+        }
+        if n.finish == Finish::Crossing {
+            // An exact finish: the parent's step up to the goal neighbourhood, checked along
+            // its whole length; a goal if it is free.
+            let par = closed[n.parent as usize];
+            let cm = &p.contacts[n.contact as usize];
+            let xi = if par.fine {
+                cm.fine_steps[n.control as usize]
+            } else {
+                cm.steps[n.control as usize]
+            };
+            let Some(t) = goal_finish(p, &par.q, &xi) else {
+                continue;
+            };
+            let part = xi * t;
+            let q = par.q.integrate(&part);
+            if !p.in_goal(&q) || !cm.body.step_free(&p.world, &par.q, &part) {
+                continue;
+            }
+            let mut transit_id = NONE;
+            if mobile && par.contact != NONE && par.contact != n.contact {
+                match transit_of(
+                    p,
+                    &closed,
+                    &mut transit_cache,
+                    &mut transits,
+                    n.parent,
+                    n.contact,
+                ) {
+                    Some(ti) => transit_id = ti,
+                    None => continue,
+                }
+            }
+            closed.push(Expanded {
+                q,
+                sc: q.theta.sin_cos(),
+                fine: par.fine,
+                frac: t,
+                contact: n.contact,
+                control: n.control,
+                parent: n.parent,
+                cost: n.cost,
+                transit: transit_id,
+            });
+            goal_node = Some((closed.len() - 1) as u32);
+            break;
+        }
         // The configuration: the start, or the parent's step (as when it was generated).
         let q = if n.parent == NONE {
             p.start
@@ -212,6 +337,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             q,
             sc: (0.0, 1.0),
             fine: false,
+            frac: 1.0,
             contact: n.contact,
             control: n.control,
             parent: n.parent,
@@ -272,16 +398,17 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 if occupied.get(cells.cell(&q2, ci as u32)) <= cost {
                     continue;
                 }
-                let f = if heur_zero {
-                    cost
+                let h = if heur_zero {
+                    0
                 } else {
-                    cost.saturating_add(heur.cost(heur.quick(&q2)))
+                    heur.cost(heur.quick(&q2))
                 };
                 // The curve of control `k` through `q2` is the one through `q`.
-                let f = f.saturating_add(heur.turn_cost(&q, sc, ci, k));
-                if f > max_cost {
+                let h = h.saturating_add(heur.turn_cost(&q, sc, ci, k));
+                if cost.saturating_add(h) > max_cost {
                     continue;
                 }
+                let f = weighted(cost, h, weight, max_cost);
                 if !lazy && !step_ok(p, &q, (sc, fine), ci, k, &q2) {
                     continue;
                 }
@@ -292,8 +419,65 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                         contact: ci as u32,
                         control: k as u32,
                         cost,
+                        finish: Finish::No,
                     },
                 );
+                // The exact finish: a step that passes through the goal neighbourhood between
+                // its ends reaches the goal at this cost (the bound there is 0).
+                let xi = if fine {
+                    &cm.fine_steps[k]
+                } else {
+                    &cm.steps[k]
+                };
+                if near_goal_of(p, &q, &q2, xi)
+                    && !p.in_goal(&q2)
+                    && goal_finish(p, &q, xi).is_some()
+                {
+                    open.push(
+                        cost.min(max_cost),
+                        Pending {
+                            parent: me,
+                            contact: ci as u32,
+                            control: k as u32,
+                            cost,
+                            finish: Finish::Crossing,
+                        },
+                    );
+                }
+            }
+        }
+        // §4.5's finish from here: one usable push of a contact straight onto the goal, tried
+        // within two steps of it (where the grid's steps may not land in a small neighbourhood).
+        let xi = q.twist_to(&p.goal);
+        if xi.norm() > 1e-12 && p.slider_reach(&xi) <= 2.0 * p.params.step {
+            for (ci, cm) in p.contacts.iter().enumerate() {
+                if !cm.usable.set.contains(&xi) {
+                    continue;
+                }
+                let Some(first) = step_cost(p, prev, ci, usize::MAX) else {
+                    continue;
+                };
+                // As many steps as its length needs, and no fewer than the bound says any
+                // plan from here takes (so that every step is a step the bound knows).
+                let unit = step_twist(&p.slider, &xi, p.params.step);
+                let n_steps =
+                    ((xi.norm() / unit.norm()).ceil().max(1.0) as u32).max(heur.steps(&q));
+                let cost = n
+                    .cost
+                    .saturating_add(first)
+                    .saturating_add(p.params.a.saturating_mul(n_steps - 1));
+                if cost <= max_cost {
+                    open.push(
+                        cost,
+                        Pending {
+                            parent: me,
+                            contact: ci as u32,
+                            control: NONE,
+                            cost,
+                            finish: Finish::Push,
+                        },
+                    );
+                }
             }
         }
     }
@@ -321,10 +505,26 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             let n = &closed[i as usize];
             let par = &closed[n.parent as usize];
             let cm = &p.contacts[n.contact as usize];
-            let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize];
+            if n.control == NONE {
+                // §4.5's finish: one push onto the goal, cut into steps.
+                let xi = par.q.twist_to(&p.goal);
+                plan.steps.extend(pushes_in_steps(
+                    p,
+                    n.contact as usize,
+                    &par.q,
+                    &[(xi, usize::MAX)],
+                    &p.goal,
+                    heur.steps(&par.q) as usize,
+                ));
+                if n.transit != NONE {
+                    plan.transits.push(transits[n.transit as usize].clone());
+                }
+                continue;
+            }
+            let xi = p.steps_at(n.contact as usize, &par.q)[n.control as usize] * n.frac;
             plan.steps.push(Step {
                 contact: n.contact as usize,
-                edge: cm.edge,
+                edge: cm.label,
                 control: n.control as usize,
                 from: par.q,
                 to: n.q,

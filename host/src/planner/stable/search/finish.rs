@@ -85,12 +85,27 @@ pub(in crate::planner::stable) fn push_steps(
     pushes: &[(V3, usize)],
     goal: &Pose,
 ) -> Vec<Step> {
-    let edge = p.contacts[ci].edge;
+    pushes_in_steps(p, ci, q, pushes, goal, 0)
+}
+
+/// As [`push_steps`], the last push cut into at least `min_last` steps.
+pub(in crate::planner::stable) fn pushes_in_steps(
+    p: &Problem,
+    ci: usize,
+    q: &Pose,
+    pushes: &[(V3, usize)],
+    goal: &Pose,
+    min_last: usize,
+) -> Vec<Step> {
+    let edge = p.contacts[ci].label;
     let mut out = Vec::new();
     let mut at = *q;
     for (j, &(xi, control)) in pushes.iter().enumerate() {
         let unit = step_twist(&p.slider, &xi, p.params.step);
-        let n = (xi.norm() / unit.norm()).ceil().max(1.0) as usize;
+        let mut n = (xi.norm() / unit.norm()).ceil().max(1.0) as usize;
+        if j + 1 == pushes.len() {
+            n = n.max(min_last);
+        }
         let tw = xi / n as f64;
         for k in 0..n {
             let from = at.integrate(&(xi * (k as f64 / n as f64)));

@@ -12,12 +12,14 @@
 //! goal exactly.
 //!
 //! The parts: `steps` (push steps, plans and their cost), `bound` (the A* lower bound), `grid`
-//! (the pruning grid), `open` (OPEN), `best_first` (the search loop), `finish` (the exact-goal
-//! finish) and `brute_force` (an unpruned search for tests).
+//! (the pruning grid), `open` (OPEN), `best_first` (the search loop), `crossing` (the goal test
+//! along a step), `finish` (the exact-goal finish) and `brute_force` (an unpruned search for
+//! tests).
 
 mod best_first;
 mod bound;
 mod brute_force;
+mod crossing;
 mod finish;
 mod grid;
 mod open;
@@ -26,6 +28,7 @@ mod steps;
 pub use best_first::{Checks, plan, plan_checked, plan_with};
 pub use bound::Heuristic;
 pub use brute_force::brute_force_cost;
+pub use crossing::{goal_crossing, goal_finish};
 pub use finish::exact_goal;
 pub(super) use finish::{backed_up, push_steps};
 pub use open::Queue;

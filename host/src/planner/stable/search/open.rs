@@ -23,6 +23,20 @@ pub(super) struct Pending {
     pub(super) contact: u32,
     pub(super) control: u32,
     pub(super) cost: u32,
+    /// A normal step, or one of the exact finishes.
+    pub(super) finish: Finish,
+}
+
+/// How a node in OPEN reaches its configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Finish {
+    /// The parent's step of `control` on `contact`.
+    No,
+    /// The parent's step only up to where it first enters the goal neighbourhood
+    /// ([`super::crossing`]).
+    Crossing,
+    /// One usable push of `contact` from the parent straight onto the goal (§4.5's finish).
+    Push,
 }
 
 /// One of the paper's FIFO lists: a vector read from `head` on.

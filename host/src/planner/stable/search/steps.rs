@@ -11,7 +11,9 @@ use crate::planner::stable::{Pose, Problem};
 pub struct Step {
     /// Index into the problem's contacts.
     pub contact: usize,
-    /// Slider edge of that contact.
+    /// Slider edge of that contact, numbered as the scene gives it ([`ContactModel::label`]).
+    ///
+    /// [`ContactModel::label`]: crate::planner::stable::ContactModel::label
     pub edge: usize,
     /// Control index within the contact's controls (`usize::MAX` for an exact-goal push).
     pub control: usize,
