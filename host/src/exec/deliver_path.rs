@@ -102,12 +102,9 @@ pub fn deliver_among_obstacles(
         };
         legs += 1;
         let d = deliver_learned_among(io, strategy, sub, &leg_params, obstacles, sink)?;
-        all.steps += d.steps;
-        all.repositions += d.repositions;
-        all.object_path += d.object_path;
-        all.robot_path += d.robot_path;
-        all.trajectory.extend(d.trajectory);
-        if d.failure == Some(Failure::Stalled) {
+        let failure = d.failure;
+        add_leg(&mut all, d);
+        if failure == Some(Failure::Stalled) {
             let o = io.object_pose().position();
             if all.recoveries.len() >= op.max_recoveries {
                 tracing::warn!(
@@ -158,16 +155,12 @@ pub fn deliver_among_obstacles(
                     ..*params
                 };
                 let d = deliver_learned_among(io, strategy, t, &side, obstacles, sink)?;
-                all.steps += d.steps;
-                all.repositions += d.repositions;
-                all.object_path += d.object_path;
-                all.robot_path += d.robot_path;
-                all.trajectory.extend(d.trajectory);
+                add_leg(&mut all, d);
             }
             continue;
         }
-        if !d.success {
-            all.failure = d.failure;
+        if failure.is_some() {
+            all.failure = failure;
             break;
         }
         spacing = op.subgoal_spacing;
@@ -188,6 +181,15 @@ pub fn deliver_among_obstacles(
         subgoals,
         path: first_path,
     })
+}
+
+/// Add one leg's pushes, paths and trajectory to the whole delivery.
+fn add_leg(all: &mut Delivery, d: Delivery) {
+    all.steps += d.steps;
+    all.repositions += d.repositions;
+    all.object_path += d.object_path;
+    all.robot_path += d.robot_path;
+    all.trajectory.extend(d.trajectory);
 }
 
 /// Back the robot off the object it stalled against: straight back by the object's clearance
