@@ -214,7 +214,16 @@ fn track(
     let (k_min, k_max) = (k_right * fp.stable_margin, k_left * fp.stable_margin);
     let n = seg.pts.len();
     let total = seg.cum[n - 1];
-    let mut idx = 0usize;
+    // Start from the nearest point of the whole path (it may be taken up half-way).
+    let (_, s0) = observe(io)?;
+    let (c0, _) = flush_pose(p, ci, &s0);
+    let mut idx = (0..n - 1)
+        .min_by(|a, b| {
+            (seg.pts[*a] - c0)
+                .norm()
+                .total_cmp(&(seg.pts[*b] - c0).norm())
+        })
+        .unwrap_or(0);
     // Enough periods for the path three times over.
     let limit = ((3.0 * total + 0.2) / fp.control_step) as usize + 20;
     for _ in 0..limit {
@@ -361,27 +370,40 @@ pub fn execute_closed_loop(
     };
     let mut contact = first.contact;
     let mut current = plan.clone();
+    // Bounds of the current plan: widened once when no plan exists from the measured pose and
+    // the current one is followed on.
+    let mut relax = 1.0;
+    // The segment to go on from, and the one being driven.
+    let (mut first_seg, mut at_seg) = (0, 0);
     loop {
         let segs = segments(p, &current);
         let mut outcome = Tracked::Done;
-        for (k, seg) in segs.iter().enumerate() {
+        let mut transits = current.transits.iter().peekable();
+        let mut fpr = *fp;
+        fpr.replan_xy *= relax;
+        fpr.replan_theta *= relax;
+        for (k, seg) in segs.iter().enumerate().skip(first_seg) {
+            at_seg = k;
             if seg.contact != contact {
-                let (_, s) = observe(io)?;
-                let tr = match current.transits.get(k.wrapping_sub(1)) {
-                    Some(t)
-                        if k > 0 && (t.from_contact, t.to_contact) == (contact, seg.contact) =>
-                    {
-                        t.clone()
+                // The plan's transit path for this change (a re-plan may start with one), or
+                // one from the observed pose.
+                let planned = transits
+                    .next_if(|t| (t.from_contact, t.to_contact) == (contact, seg.contact))
+                    .cloned();
+                let tr = match planned {
+                    Some(t) => t,
+                    None => {
+                        let (_, s) = observe(io)?;
+                        transit(p, &s, contact, seg.contact, 0).ok_or_else(|| {
+                            anyhow::anyhow!("no transit path {contact} → {}", seg.contact)
+                        })?
                     }
-                    _ => transit(p, &s, contact, seg.contact, 0).ok_or_else(|| {
-                        anyhow::anyhow!("no transit path {contact} → {}", seg.contact)
-                    })?,
                 };
                 drive_transit(p, &tr, io)
                     .with_context(|| format!("transit {contact} → {}", seg.contact))?;
                 contact = seg.contact;
             }
-            outcome = track(p, seg, io, fp, &mut run, k + 1 == segs.len())?;
+            outcome = track(p, seg, io, &fpr, &mut run, k + 1 == segs.len())?;
             if outcome != Tracked::Done {
                 break;
             }
@@ -424,7 +446,11 @@ pub fn execute_closed_loop(
             next.as_ref().map(|pl| (pl.steps.len(), pl.exact_goal))
         );
         match next {
-            Some(pl) if !pl.steps.is_empty() => current = pl,
+            Some(pl) if !pl.steps.is_empty() => {
+                current = pl;
+                relax = 1.0;
+                first_seg = 0;
+            }
             Some(_) => {
                 run.reached = p.in_goal(&s);
                 break;
@@ -432,6 +458,11 @@ pub fn execute_closed_loop(
             None if p.in_goal(&s) => {
                 run.reached = true;
                 break;
+            }
+            None if relax == 1.0 && outcome == Tracked::OffPath => {
+                // Keep following the plan it left (from where it is, with wider bounds).
+                relax = 2.0;
+                first_seg = at_seg;
             }
             None => {
                 run.failure = Some(format!(
