@@ -26,6 +26,7 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
             "pushbot eval: not a delivery evaluation",
         ));
     };
+    let a = *a;
     if !(a.time_limit.is_finite() && a.time_limit > 0.0) {
         return Err(CliError::bad_input("--time-limit must be positive"));
     }
