@@ -108,3 +108,31 @@ impl Scene {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with(section: &str) -> Result<Scene, crate::SceneError> {
+        let mut t = crate::presets::text("fig15").expect("fig15");
+        t.push_str(section);
+        Scene::from_toml(&t, "perturbed.toml")
+    }
+
+    #[test]
+    fn missing_fields_take_the_defaults_and_bad_ones_name_their_field() {
+        let s = with("\n[perturb]\nstart_theta_deg = 2.0\n").unwrap();
+        let p = s.perturb.unwrap();
+        assert_eq!(p.start_theta_deg, 2.0);
+        assert_eq!(p.pusher_friction, Perturb::default().pusher_friction);
+        assert_eq!(with("").unwrap().perturb, None);
+        for (bad, field) in [
+            ("start_xy = -0.01", "perturb.start_xy"),
+            ("support_friction = 1.0", "perturb.support_friction"),
+            ("camera_xy = nan", "perturb.camera_xy"),
+        ] {
+            let e = with(&format!("\n[perturb]\n{bad}\n")).unwrap_err();
+            assert_eq!(e.field.as_deref(), Some(field), "{e}");
+        }
+    }
+}
