@@ -6,9 +6,8 @@
 //! a pty with its rendered camera) or `--port`/`--camera` (a real robot).
 
 use clap::{Args, Subcommand};
-use serde_json::json;
 
-use super::{CliError, CliResult, Global, Status};
+use super::{CliError, CliResult, Global};
 
 /// `pushbot run`: one task on the robot.
 #[derive(Subcommand, Debug)]
@@ -106,7 +105,9 @@ pub fn eval(g: &Global, a: &StableEvalArgs) -> CliResult {
 #[cfg(feature = "sim")]
 fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     use rayon::prelude::*;
+    use serde_json::json;
 
+    use super::Status;
     use crate::experiments::stable_trials::{StableTask, StableTrial, run_trial, run_trial_live};
     let r = &a.run;
     r.check()?;
@@ -205,6 +206,7 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
 }
 
 #[cfg(not(feature = "sim"))]
-fn eval_or_run(_g: &Global, _a: &StableEvalArgs, _single: bool) -> CliResult {
+fn eval_or_run(_g: &Global, a: &StableEvalArgs, _single: bool) -> CliResult {
+    a.run.check()?;
     Err(super::no_simulated_target())
 }
