@@ -17,6 +17,7 @@ pub mod encoder;
 pub mod fault_pipe;
 pub mod faults;
 pub mod motor;
+pub mod perturb;
 pub mod plug;
 pub mod pty;
 pub mod pushing;

@@ -61,6 +61,9 @@ pub struct SimOptions {
     pub unplugs: Vec<crate::plug::Unplug>,
     /// Objects moved by hand at given times ([`Disturbance`]).
     pub disturbances: Vec<Disturbance>,
+    /// A perturbed world ([`crate::perturb`]): applied to `scene` (its object's start, friction
+    /// and centre of friction) and to the hardware (wheel slip). Needs `scene`.
+    pub perturb: Option<crate::perturb::Perturbation>,
 }
 
 /// An object moved by hand mid-run (issue 22): at `at_s` seconds of simulated time `object` is
@@ -128,6 +131,7 @@ impl Default for SimOptions {
             link: None,
             unplugs: Vec::new(),
             disturbances: Vec::new(),
+            perturb: None,
         }
     }
 }
@@ -155,6 +159,7 @@ impl SimOptions {
                 camera: crate::scene::CameraSpec::default(),
                 rearrange: None,
                 stable: None,
+                perturb: None,
             },
         }
     }
@@ -188,10 +193,18 @@ impl Sim {
         if opts.substeps == 0 || opts.substeps > 1000 {
             bail!("substeps must be 1..=1000, not {}", opts.substeps);
         }
-        let (robot, hardware) = built_for(opts);
+        let (robot, mut hardware) = built_for(opts);
         let body = crate::world::body_from_geometry(&robot.geometry);
+        let mut scene = opts.scene.clone();
+        if let Some(p) = &opts.perturb {
+            let Some(s) = scene.as_mut() else {
+                bail!("a perturbed world needs a scene");
+            };
+            p.apply(s)?;
+            hardware.wheel_slip = p.wheel_slip;
+        }
         // The world's and the sensors' noise come from separate streams of the one seed.
-        let world = match &opts.scene {
+        let world = match &scene {
             Some(scene) => World::from_scene(scene, body, hardware, opts.seed)?,
             None => World::new(opts.table, opts.start, body, hardware, opts.seed)?,
         };

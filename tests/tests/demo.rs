@@ -22,6 +22,14 @@ fn the_stable_stage_runs_and_writes_the_report() {
     let stage = &summary["stages"][0];
     assert_eq!(stage["id"], "stable");
     assert!(stage["numbers"]["pushed_m"].as_f64().expect("pushed") > 0.3);
+    // Closed loop (issue 21): it counts its re-plans, and the plan figure draws the executed
+    // path (green) over the planned one.
+    assert!(stage["numbers"]["replans"].as_u64().is_some(), "{stage:#}");
+    let plan_svg = std::fs::read_to_string(out.join("stable-plan.svg")).expect("stable-plan.svg");
+    assert!(
+        plan_svg.contains("#0a4"),
+        "no executed path in stable-plan.svg"
+    );
     let page = std::fs::read_to_string(out.join("report.html")).expect("report.html");
     for f in ["stable-plan.svg", "stable-run.svg"] {
         assert!(out.join(f).exists(), "{f} missing");

@@ -7,8 +7,8 @@
 //!    (or reuse the cached one), then deliver the object to its goal among obstacles;
 //! 2. **rearrange** (Ben-Shahar & Rivlin): plan an optimal rearrangement of two boxes (cost map
 //!    and restoration) and execute it, re-observing and snapping to the grid;
-//! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and execute
-//!    them open loop.
+//! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and drive
+//!    them closed loop.
 //!
 //! It writes a report folder (`report.html`, `summary.json`, figures, `demo.log`) and prints its
 //! path. The pipeline is [`crate::experiments::demo`]; this module parses and prints.

@@ -18,6 +18,7 @@ pub mod replay;
 pub mod robot;
 pub mod scene;
 pub mod stable;
+pub mod stable_run;
 pub mod strategy;
 pub mod strategy_args;
 #[cfg(feature = "sim")]
@@ -104,6 +105,9 @@ pub enum Command {
     Collect(strategy_args::CollectArgs),
     /// Evaluate: `eval delivery` (Lau et al. Fig. 11, learned vs dipole).
     Eval(strategy_args::EvalArgs),
+    /// Run one task on the robot (simulated or real).
+    #[command(subcommand)]
+    Run(stable_run::RunCommand),
     /// Calibrate the overhead camera from markers at known table positions; `calibrate lens`
     /// finds the lens's intrinsics and distortion from frames of a printed board
     /// (`calibrate board` writes it).
@@ -260,6 +264,18 @@ pub const EXAMPLES: &[(&str, &str)] = &[
         "bench knn",
         "pushbot bench knn --samples 10000 --queries 500",
     ),
+    (
+        "eval stable",
+        "pushbot eval stable --scene fig15 --trials 20 --perturb --seed 1 --json",
+    ),
+    (
+        "run",
+        "pushbot run stable --scene fig15 --perturb --trial 3",
+    ),
+    (
+        "run stable",
+        "pushbot run stable --scene fig15 --perturb --trial 3 --hil",
+    ),
     ("scene", "pushbot scene check --scene my-table.toml"),
     (
         "scene check",
@@ -387,7 +403,11 @@ pub fn run(cli: Cli) -> CliResult {
             strategy::run_bench(&global, strategy_args::BenchArgs { cmd })
         }
         Command::Collect(args) => strategy::run_collect(&global, args),
+        Command::Eval(strategy_args::EvalArgs {
+            cmd: strategy_args::EvalCmd::Stable(a),
+        }) => stable_run::eval(&global, &a),
         Command::Eval(args) => strategy::run_eval(&global, args),
+        Command::Run(cmd) => stable_run::run(&global, cmd),
         Command::Scene(cmd) => scene::run(&global, cmd),
     }
 }

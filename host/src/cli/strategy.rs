@@ -21,7 +21,12 @@ use crate::strategy::store;
 
 /// Run `pushbot eval`.
 pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
-    let EvalCmd::Delivery(a) = a.cmd;
+    let EvalCmd::Delivery(a) = a.cmd else {
+        return Err(CliError::bad_input(
+            "pushbot eval: not a delivery evaluation",
+        ));
+    };
+    let a = *a;
     if !(a.time_limit.is_finite() && a.time_limit > 0.0) {
         return Err(CliError::bad_input("--time-limit must be positive"));
     }

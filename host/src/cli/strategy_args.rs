@@ -92,7 +92,9 @@ pub struct EvalArgs {
 #[derive(Subcommand, Debug)]
 pub enum EvalCmd {
     /// Deliver the object from named start positions to the goal (Lau et al. Fig. 10–11).
-    Delivery(DeliveryArgs),
+    Delivery(Box<DeliveryArgs>),
+    /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds (issue 21).
+    Stable(super::stable_run::StableEvalArgs),
 }
 
 /// Which delivery methods to run.

@@ -8,6 +8,8 @@
 //! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals;
 //! - [`rearrange`]: Ben-Shahar & Rivlin's plans driven with re-observation and snapping;
 //! - [`stable`]: Lynch & Mason's stable pushes on the plated robot, with transits;
+//! - [`stable_feedback`]: the same plans driven closed loop: steering inside the stable set,
+//!   re-planning from the measured poses, re-acquiring a lost edge;
 //! - [`primitive`]: one motion primitive as a task, resumed from the odometry through link
 //!   breaks (`pushbot robot move`);
 //! - [`live`]: the [`RobotIo`](crate::exec::io::RobotIo) over a real serial link
@@ -27,6 +29,7 @@ pub mod primitive;
 pub mod rearrange;
 pub mod record;
 pub mod stable;
+pub mod stable_feedback;
 pub mod view;
 
 pub use live::{LiveOptions, LiveRobot};

@@ -56,7 +56,7 @@ fn relative(robot: Pose, slider: Pose) -> Pose {
 }
 
 /// The observed poses of the robot (axle centre, heading) and the slider.
-fn observe(io: &mut dyn RobotIo) -> Result<(Pose, Pose)> {
+pub(crate) fn observe(io: &mut dyn RobotIo) -> Result<(Pose, Pose)> {
     let rp = io.robot_pose();
     let sp = io
         .body_pose("slider")
@@ -151,7 +151,7 @@ fn to_slider(q: &Pose, w: V2) -> V2 {
 
 /// Where the axle centre is (world) and which way the robot faces when its plate is flush on
 /// contact `ci` of the slider at `s`.
-fn flush_pose(p: &Problem, ci: usize, s: &Pose) -> (V2, V2) {
+pub(crate) fn flush_pose(p: &Problem, ci: usize, s: &Pose) -> (V2, V2) {
     let (axle, heading) = robot_in_slider(p, ci);
     (s.apply(axle), s.rotate(heading))
 }

@@ -6,8 +6,8 @@
 //!    (or reuse the cached one), then deliver the object to its goal among obstacles;
 //! 2. **rearrange** (Ben-Shahar & Rivlin): plan an optimal rearrangement of two boxes (cost map
 //!    and restoration) and execute it, re-observing and snapping to the grid;
-//! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and execute
-//!    them open loop.
+//! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and drive
+//!    them closed loop (the camera watching every push; issue 21).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -503,57 +503,65 @@ fn stage_rearrange(
     Ok(st)
 }
 
-/// Lynch & Mason: plan stable pushes for the plated robot, execute them open loop.
+/// Lynch & Mason: plan stable pushes for the plated robot (the preset's robot-scale version,
+/// [`crate::experiments::stable_trials::ROBOT_SCALE`]), drive them closed loop
+/// ([`crate::exec::stable_feedback`]): the camera watches the slider during every push.
 fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
-    use crate::exec::stable::execute;
-    use crate::planner::stable::robot::{robot_problem, robot_start, sim_scene};
-    use crate::planner::stable::{plan, svg};
+    use crate::exec::stable_feedback::{FeedbackParams, execute_closed_loop};
+    use crate::experiments::stable_trials::StableTask;
+    use crate::planner::stable::svg;
 
     let mut st = StageReport::new(
         "stable",
-        &format!("Stable pushing of the slider among obstacles ({name})"),
-        "Lynch & Mason §3 (STABLE), §4 (planner)",
+        &format!("Stable pushing of the slider among obstacles ({name}), closed loop"),
+        "Lynch & Mason §3 (STABLE), §4 (planner); closed loop inside the stable set (issue 21)",
     );
     let pb = ctx.bar("stable");
     pb.set_message("planning stable pushes for the plated robot");
-    let (s, p) = robot_problem(name, None)?;
-    let pl = plan(&p);
+    let task = match StableTask::load(name) {
+        Ok(t) => t,
+        Err(e) => {
+            st.notes.push(format!("{e:#}"));
+            return Ok(st);
+        }
+    };
+    let (p, pl) = (&task.problem, &task.plan);
     st.number("found", pl.found);
     st.number("plan_cost", pl.cost);
     st.number("pushes_planned", pl.pushes);
     st.number("nodes_expanded", pl.nodes_expanded);
     st.number("plan_ms", pl.plan_time_ms);
-    let f = ctx
-        .report
-        .figure("stable-plan", &svg::render(&p, Some(&pl)))?;
-    st.figures
-        .push((f, "The plan over stable pushes (Fig. 13–18 style)".into()));
-    if !pl.found {
-        st.notes
-            .push("no plan of stable pushes exists for this robot".into());
-        return Ok(st);
-    }
-    let start = robot_start(&p, &pl).ok_or_else(|| anyhow!("the plan has no step"))?;
-    let scene = sim_scene(&s, &p, start, 1)?;
-    pb.set_message("pushing open loop through the serial port");
+    let scene = task.sim_scene()?;
+    pb.set_message("pushing closed loop through the serial port and the camera");
     let ids = vec!["slider".to_string()];
-    let ((pushes, end), trace) =
-        ctx.with_robot(&scene, Some("slider"), &ids, |io| execute(&p, &pl, io))?;
+    let (run, trace) = ctx.with_robot(&scene, Some("slider"), &ids, |io| {
+        execute_closed_loop(p, pl, io, &FeedbackParams::default())
+    })?;
     pb.finish_and_clear();
-    let pushed: f64 = pushes.iter().map(|r| r.pushed).sum();
-    let worst = pushes
-        .iter()
-        .map(|r| r.drift / r.pushed.max(0.01))
-        .fold(0.0, f64::max);
-    let worst_angle = pushes.iter().map(|r| r.drift_angle).fold(0.0, f64::max);
+    // The truth where the simulated target reports it, else the camera.
+    let end = trace
+        .last()
+        .and_then(|t| t.truth.as_ref())
+        .and_then(|(_, objects)| objects.iter().find(|(id, _)| id == "slider"))
+        .map_or(run.end, |(_, q)| {
+            crate::planner::stable::Pose::new(q.x, q.y, q.theta)
+        });
     st.success = p.in_goal(&end);
     st.mission_s = trace.last().map_or(0.0, |t| t.t - trace[0].t);
-    st.number("pushed_m", pushed);
-    st.number("worst_drift_per_100mm_mm", worst * 100.0);
-    st.number("worst_drift_deg", worst_angle.to_degrees());
+    st.number("pushed_m", run.pushed);
+    st.number("replans", run.replans);
+    st.number("contact_losses", run.contact_losses);
+    st.number("replan_ms", run.replan_ms);
     st.number("end_x", end.x);
     st.number("end_y", end.y);
     st.number("end_theta_deg", end.theta.to_degrees());
+    st.number(
+        "final_error_mm",
+        (end.x - p.goal.x).hypot(end.y - p.goal.y) * 1e3,
+    );
+    if let Some(why) = &run.failure {
+        st.notes.push(format!("the closed loop stopped: {why}"));
+    }
     if !st.success {
         st.notes.push(format!(
             "the slider ended at ({:.3}, {:.3}, {:.1}°), outside the goal neighbourhood",
@@ -562,18 +570,27 @@ fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
             end.theta.to_degrees()
         ));
     }
+    let f = ctx
+        .report
+        .figure("stable-plan", &svg::render_executed(p, Some(pl), &run.path))?;
+    st.figures.push((
+        f,
+        "The plan over stable pushes (Fig. 13–18 style, planned path blue) and the slider's \
+         executed path as the camera saw it (green)"
+            .into(),
+    ));
     let f = ctx.report.figure(
         "stable-run",
         &figure::run_svg(
             &scene,
             &trace,
-            "stable pushes executed open loop (truth)",
+            "stable pushes executed closed loop (truth)",
             true,
         ),
     )?;
     st.figures.push((
         f,
-        "Open-loop execution: the slider stays on the plate".into(),
+        "Closed-loop execution on the robot: robot blue, slider red".into(),
     ));
     Ok(st)
 }

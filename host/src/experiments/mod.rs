@@ -9,6 +9,8 @@
 //! - `demo`: the demo's three stages, one per paper, into a report.
 //! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
 //!   planner on large rooms (`pushbot bench rearrange`).
+//! - `stable_trials`: stable pushing (Lynch & Mason §4) open and closed loop in perturbed
+//!   simulated worlds (`pushbot run stable`, `pushbot eval stable`; issue 21).
 //! - `link_bench`: commands through a faulty wire to the in-process target (`pushbot bench
 //!   link`).
 
@@ -19,6 +21,8 @@ pub mod demo;
 #[cfg(feature = "sim")]
 pub mod link_bench;
 pub mod rearrange_bench;
+#[cfg(feature = "sim")]
+pub mod stable_trials;
 #[cfg(feature = "sim")]
 pub mod strategy_eval;
 pub mod trials;

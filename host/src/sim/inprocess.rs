@@ -98,10 +98,21 @@ impl InProcess {
         seed: u64,
         opts: ClientOptions,
     ) -> anyhow::Result<InProcess> {
+        InProcess::start_perturbed(scene, seed, None, opts)
+    }
+
+    /// As [`InProcess::start`], the world perturbed by `perturb` ([`pushbot_sim::perturb`]).
+    pub fn start_perturbed(
+        scene: pushbot_world::Scene,
+        seed: u64,
+        perturb: Option<pushbot_sim::perturb::Perturbation>,
+        opts: ClientOptions,
+    ) -> anyhow::Result<InProcess> {
         let sim = Sim::new(&pushbot_sim::SimOptions {
             seed,
             speed: 0.0,
             scene: Some(scene),
+            perturb,
             ..pushbot_sim::SimOptions::default()
         })?;
         Ok(InProcess::new(sim, opts))

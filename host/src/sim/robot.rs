@@ -80,10 +80,23 @@ impl SimRobot {
     /// A simulated robot in `scene`, pushing object `object_id` (the first object when `None`),
     /// which is placed at the scene's named position `start` when given.
     pub fn new(
+        scene: Scene,
+        object_id: Option<&str>,
+        start: Option<&str>,
+        opts: SimRobotOptions,
+    ) -> Result<SimRobot> {
+        SimRobot::perturbed(scene, object_id, start, opts, None)
+    }
+
+    /// As [`SimRobot::new`], in the perturbed world `perturb` (issue 21,
+    /// [`pushbot_sim::perturb`]): the simulated world runs its start error, frictions, centre of
+    /// friction and wheel slip; the camera noise stays `opts`'s.
+    pub fn perturbed(
         mut scene: Scene,
         object_id: Option<&str>,
         start: Option<&str>,
         opts: SimRobotOptions,
+        perturb: Option<pushbot_sim::perturb::Perturbation>,
     ) -> Result<SimRobot> {
         let object = match object_id {
             Some(id) => scene
@@ -140,7 +153,7 @@ impl SimRobot {
             dead_link_timeout: Duration::from_secs(PRIMITIVE_LIMIT_S),
             ..LinkOptions::default()
         };
-        let driver = InProcess::start(scene, opts.seed, link.client_options(1))?;
+        let driver = InProcess::start_perturbed(scene, opts.seed, perturb, link.client_options(1))?;
         let robot = Robot::over(driver, link)
             .map_err(|e| anyhow!("the simulated robot refused the session: {e}"))?;
         let cfg = ConfigUpdate {

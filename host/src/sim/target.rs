@@ -69,6 +69,30 @@ impl SimTarget {
         Ok(SimTarget { sim, camera })
     }
 
+    /// Serve `scene` as [`SimTarget::start`] does (no frames kept, no link faults), in the
+    /// perturbed world `perturb` ([`pushbot_sim::perturb`]).
+    pub fn start_perturbed(
+        scene: &Scene,
+        seed: u64,
+        speed: f64,
+        perturb: Option<pushbot_sim::perturb::Perturbation>,
+    ) -> Result<SimTarget> {
+        let sim = PtySim::start(SimOptions {
+            seed,
+            speed,
+            perturb,
+            scene: Some(scene.clone()),
+            camera: Some(LiveCameraOptions::default()),
+            ..SimOptions::default()
+        })
+        .context("starting the built-in simulated target")?;
+        let camera = match sim.camera_addr() {
+            Some(a) => Some(format!("sim:{a}")),
+            None => anyhow::bail!("the simulated target started without its camera"),
+        };
+        Ok(SimTarget { sim, camera })
+    }
+
     /// Serve only the robot's serial port (no camera): the scene's robot and world, or the
     /// default empty table when `scene` is `None` (`pushbot robot …` without `--port`).
     pub fn start_robot(scene: Option<&Scene>, seed: u64, speed: f64) -> Result<SimTarget> {

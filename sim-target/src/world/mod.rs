@@ -67,6 +67,9 @@ pub struct Hardware {
     /// Each step each wheel's rim speed over the ground is off by a relative error drawn
     /// uniformly from ±`slip_noise` (small random slip that averages out).
     pub slip_noise: f64,
+    /// Each wheel's systematic rim-speed error over the ground (share; left, right): a slip
+    /// the encoders cannot see, which makes the robot veer (issue 21's perturbed worlds).
+    pub wheel_slip: [f64; 2],
     /// Probability that one encoder reading is off by ±1 count.
     pub encoder_jitter: f64,
     /// Longest bumper-switch bounce after a change, µs.
@@ -82,6 +85,7 @@ impl Default for Hardware {
             drive_wheel_load: 0.4,
             traction_mu: 1.0,
             slip_noise: 0.01,
+            wheel_slip: [0.0; 2],
             encoder_jitter: 1e-4,
             bounce_us: 2_000,
         }

@@ -261,7 +261,7 @@ impl World {
             } else {
                 0.0
             };
-            rim[i] = rolling[i] * r * (1.0 + noise);
+            rim[i] = rolling[i] * r * (1.0 + noise + self.hw.wheel_slip[i]);
         }
         let (v, omega) = twist_from_wheels(rim, b);
         let (dx, dy, dth) = arc_displacement(self.pose.theta, v, omega, dt);

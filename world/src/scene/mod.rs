@@ -54,6 +54,7 @@ mod validate;
 pub use camera::{CameraSpec, InlineIntrinsics, IntrinsicsSpec, Occluder};
 pub use error::SceneError;
 use error::{Seg, key_before, line_col, path_string, span_of};
+pub mod perturb;
 pub mod rearrange;
 pub mod stable;
 
@@ -90,6 +91,9 @@ pub struct Scene {
     /// A stable-pushing task for the host's planner (the sim ignores it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stable: Option<stable::Stable>,
+    /// How far the simulated world may differ from the model (`--perturb`; see [`perturb`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub perturb: Option<perturb::Perturb>,
 }
 
 /// The table: a rectangle with its origin at the lower-left corner; its edges are walls.

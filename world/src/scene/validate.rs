@@ -144,6 +144,7 @@ impl Scene {
             }
         }
         self.check_sections()?;
+        self.check_perturb()?;
         self.check_geometry()
     }
 

@@ -150,6 +150,7 @@ pub fn scene_for(problem: &Problem, opts: &SceneOptions) -> Result<pushbot_world
             opts.kg_per_mass,
         )),
         stable: None,
+        perturb: None,
     };
     // Round-trip through the checked loader so the scene is one the simulator accepts.
     pushbot_world::Scene::from_toml(&scene.to_toml(), &format!("grid scene {}", problem.name))

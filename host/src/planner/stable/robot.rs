@@ -43,10 +43,20 @@ pub fn robot_problem_edges(
     edges: &[usize],
     contact_cost: Option<u32>,
 ) -> Result<(StableScene, Problem)> {
+    robot_problem_in(load_scene(name)?, goal_theta_deg, edges, contact_cost)
+}
+
+/// [`robot_problem_edges`] on an already loaded (or changed) stable scene `s`.
+pub fn robot_problem_in(
+    mut s: StableScene,
+    goal_theta_deg: Option<f64>,
+    edges: &[usize],
+    contact_cost: Option<u32>,
+) -> Result<(StableScene, Problem)> {
+    let name = s.name.clone();
     if edges.is_empty() {
         bail!("robot problem {name}: no edge to push on");
     }
-    let mut s = load_scene(name)?;
     if let Some(g) = goal_theta_deg {
         if !(g.is_finite() && g > 0.0) {
             bail!("robot problem {name}: goal heading tolerance {g}° must be finite and > 0");

@@ -13,6 +13,11 @@ const AXES_MARGIN: f64 = 44.0;
 
 /// Render a plan (or just the problem if no plan) as an SVG document.
 pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
+    render_executed(p, plan, &[])
+}
+
+/// [`render`] with the slider's executed path (table m) drawn over the planned one, in green.
+pub fn render_executed(p: &Problem, plan: Option<&Plan>, executed: &[[f64; 2]]) -> String {
     let (w, h) = p.world.table;
     let f = Frame::table(w, h, SIDE / w.max(h)).with_margin(AXES_MARGIN);
     let map = |pts: &[V2]| -> Vec<[f64; 2]> { pts.iter().map(|v| f.map([v.x, v.y])).collect() };
@@ -73,6 +78,9 @@ pub fn render(p: &Problem, plan: Option<&Plan>) -> String {
             &f.map_all(&t.waypoints),
             &Style::outline("#a0a", 1.5).dash("3 3"),
         );
+    }
+    if executed.len() > 1 {
+        d.polyline(&f.map_all(executed), &Style::outline("#0a4", 2.0));
     }
     d.to_string()
 }

@@ -1,0 +1,212 @@
+//! `pushbot run stable` and `pushbot eval stable`: Lynch & Mason's stable pushes (§4) planned
+//! for the plated robot and driven closed loop (issue 21; [`crate::exec::stable_feedback`]) —
+//! or open loop, as the paper drives them, with `--open-loop` — on the in-process simulated
+//! robot, perturbed with `--perturb` (the scene's `[perturb]` ranges, seeded by `--seed` and
+//! the trial number); through a serial port and a camera with `--hil` (the built-in target on
+//! a pty with its rendered camera) or `--port`/`--camera` (a real robot).
+
+use clap::{Args, Subcommand};
+
+use super::{CliError, CliResult, Global};
+
+/// `pushbot run`: one task on the robot.
+#[derive(Subcommand, Debug)]
+pub enum RunCommand {
+    /// Plan stable pushes for the plated robot and drive them closed loop, once.
+    Stable(StableRunArgs),
+}
+
+/// The arguments `run stable` and `eval stable` share.
+#[derive(Args, Debug, Clone)]
+pub struct StableRunArgs {
+    /// A preset (fig13, fig15, fig16, fig17, fig18: its robot-scale version, the robot's plate
+    /// pushing on edge 0) or a scene file with a `[stable]` section whose pusher is a
+    /// `diff-drive`.
+    #[arg(long)]
+    pub scene: String,
+    /// Perturb the simulated world: start pose, frictions, centre of friction, wheel slip and
+    /// camera noise drawn from the scene's `[perturb]` ranges (defaults: ±5°, ±10 mm, ±30 %,
+    /// 5 mm, ±0.5 %, 1 mm and 0.5°), seeded by --seed and the trial number. The planner keeps
+    /// the nominal model.
+    #[arg(long)]
+    pub perturb: bool,
+    /// Drive the plan open loop (as the paper does), for comparison.
+    #[arg(long)]
+    pub open_loop: bool,
+    /// The trial number (`run stable`) or the first one (`eval stable`): with --seed, it picks
+    /// the perturbed world.
+    #[arg(long, default_value_t = 1)]
+    pub trial: u64,
+    /// Through a serial port and the camera: the built-in simulated target on a pty with its
+    /// rendered camera (AprilTag detection and tracking in the loop), one trial at a time.
+    #[arg(long)]
+    pub hil: bool,
+    /// A real robot's serial port (with --camera); the perturbation does not apply there.
+    #[arg(long, requires = "camera")]
+    pub port: Option<String>,
+    /// The overhead camera (/dev/videoN, a folder, sim:HOST:PORT), with --port.
+    #[arg(long, requires = "port")]
+    pub camera: Option<String>,
+    /// With --hil: simulated seconds per wall second.
+    #[arg(long = "sim-speed", default_value_t = 8.0)]
+    pub speed: f64,
+}
+
+/// `pushbot eval stable`.
+#[derive(Args, Debug, Clone)]
+pub struct StableEvalArgs {
+    #[command(flatten)]
+    pub run: StableRunArgs,
+    /// Number of trials (trials --trial … --trial + N − 1).
+    #[arg(long, default_value_t = 20)]
+    pub trials: u64,
+}
+
+impl StableRunArgs {
+    fn check(&self) -> Result<(), CliError> {
+        if !(self.speed.is_finite() && self.speed > 0.0 && self.speed <= 50.0) {
+            return Err(CliError::bad_input(format!(
+                "--sim-speed must be in (0, 50], not {}",
+                self.speed
+            )));
+        }
+        if self.hil && self.port.is_some() {
+            return Err(CliError::bad_input(
+                "--hil runs the built-in simulated target; --port a real robot: give one",
+            ));
+        }
+        if self.perturb && self.port.is_some() {
+            return Err(CliError::bad_input(
+                "--perturb perturbs the simulated world, not a real robot's (with --port)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Run `pushbot run stable`.
+pub fn run(g: &Global, cmd: RunCommand) -> CliResult {
+    let RunCommand::Stable(a) = cmd;
+    let e = StableEvalArgs { run: a, trials: 1 };
+    eval_or_run(g, &e, true)
+}
+
+/// Run `pushbot eval stable`.
+pub fn eval(g: &Global, a: &StableEvalArgs) -> CliResult {
+    if !(1..=10_000).contains(&a.trials) {
+        return Err(CliError::bad_input(format!(
+            "--trials must be 1..=10000, not {}",
+            a.trials
+        )));
+    }
+    eval_or_run(g, a, false)
+}
+
+#[cfg(feature = "sim")]
+fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
+    use rayon::prelude::*;
+    use serde_json::json;
+
+    use super::Status;
+    use crate::experiments::stable_trials::{StableTask, StableTrial, run_trial, run_trial_live};
+    let r = &a.run;
+    r.check()?;
+    let task = StableTask::load(&r.scene).map_err(|e| CliError::bad_input(format!("{e:#}")))?;
+    if let (Some(port), Some(camera)) = (&r.port, &r.camera) {
+        drop(crate::link::transport::open(port).map_err(|e| CliError::bad_input(format!("{e}")))?);
+        crate::exec::grabber::FrameGrabber::open(camera, 30.0)
+            .map_err(|e| CliError::bad_input(format!("--camera {camera}: {e}")))?;
+    }
+    let trials: Vec<u64> = (r.trial..r.trial + a.trials).collect();
+    let pb = super::strategy_args::progress_bar(g, trials.len() as u64);
+    pb.set_message(format!(
+        "{} {} loop{}",
+        r.scene,
+        if r.open_loop { "open" } else { "closed" },
+        if r.perturb { ", perturbed" } else { "" }
+    ));
+    let one = |t: u64| -> anyhow::Result<StableTrial> {
+        let pert = task.perturbation(g.seed, t, r.perturb);
+        let out = if r.hil || r.port.is_some() {
+            let robot = r.port.as_deref().zip(r.camera.as_deref());
+            run_trial_live(&task, t, g.seed, pert, !r.open_loop, robot, r.speed)
+        } else {
+            run_trial(&task, t, g.seed, pert, !r.open_loop)
+        };
+        pb.inc(1);
+        out
+    };
+    let results: Vec<anyhow::Result<StableTrial>> = if r.hil || r.port.is_some() {
+        trials.iter().map(|t| one(*t)).collect()
+    } else {
+        trials.par_iter().map(|t| one(*t)).collect()
+    };
+    pb.finish_and_clear();
+    let mut rows = Vec::new();
+    for (t, res) in trials.iter().zip(results) {
+        rows.push(res.map_err(|e| CliError::Failed(e.context(format!("trial {t}"))))?);
+    }
+    let reached = rows.iter().filter(|t| t.reached).count();
+    let n = rows.len();
+    let mean = |f: &dyn Fn(&StableTrial) -> f64| rows.iter().map(f).sum::<f64>() / n as f64;
+    let summary = json!({
+        "scene": r.scene,
+        "closed_loop": !r.open_loop,
+        "perturbed": r.perturb,
+        "seed": g.seed,
+        "trials": n,
+        "reached": reached,
+        "plan_pushes": task.plan.pushes,
+        "plan_ms": task.plan.plan_time_ms,
+        "mean_final_error_mm": mean(&|t| t.final_error_m * 1e3),
+        "worst_final_error_mm": rows.iter().map(|t| t.final_error_m * 1e3).fold(0.0, f64::max),
+        "mean_replans": mean(&|t| t.replans as f64),
+        "contact_losses": rows.iter().map(|t| t.contact_losses).sum::<usize>(),
+    });
+    if g.json {
+        println!("{}", json!({ "summary": summary, "trials": rows }));
+    } else {
+        println!(
+            "{} ({} loop{}, seed {}): goal ±{:.0} mm, ±{:.1}°",
+            r.scene,
+            if r.open_loop { "open" } else { "closed" },
+            if r.perturb { ", perturbed" } else { "" },
+            g.seed,
+            task.problem.params.goal_xy * 1e3,
+            task.problem.params.goal_theta.to_degrees()
+        );
+        println!("trial  reached  error mm   error °  re-plans  contact losses");
+        for t in &rows {
+            println!(
+                "{:5}  {:7}  {:8.1}  {:8.2}  {:8}  {:14}{}",
+                t.trial,
+                if t.reached { "yes" } else { "NO" },
+                t.final_error_m * 1e3,
+                t.final_error_deg,
+                t.replans,
+                t.contact_losses,
+                t.failure
+                    .as_ref()
+                    .map_or(String::new(), |f| format!("  ({f})"))
+            );
+        }
+        println!(
+            "reached {reached} of {n}; mean final error {:.1} mm; mean re-plans {:.1}",
+            mean(&|t| t.final_error_m * 1e3),
+            mean(&|t| t.replans as f64)
+        );
+    }
+    // `run` fails when the goal was missed; `eval` reports its numbers either way.
+    let ok = !single || reached == n;
+    Ok(if ok {
+        Status::Success
+    } else {
+        Status::TaskFailed
+    })
+}
+
+#[cfg(not(feature = "sim"))]
+fn eval_or_run(_g: &Global, a: &StableEvalArgs, _single: bool) -> CliResult {
+    a.run.check()?;
+    Err(super::no_simulated_target())
+}
