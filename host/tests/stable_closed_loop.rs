@@ -88,3 +88,47 @@ fn an_unknown_scene_is_an_error() {
     let e = StableTask::load("no-such-scene").unwrap_err();
     assert!(format!("{e:#}").contains("no-such-scene"), "{e:#}");
 }
+
+/// A scene file's own `[stable]` section is what runs (D4): its edges, start edge, contact
+/// cost, goal tolerance and the robot's plate, not the presets' defaults.
+#[test]
+fn a_scene_files_stable_section_is_what_runs() {
+    let text = r#"name = "own"
+[table]
+width = 1.2
+height = 1.0
+[robot]
+start = { x = 0.12, y = 0.5, theta = 0.0 }
+front_plate = { width = 0.1, offset = 0.05 }
+[[objects]]
+id = "s"
+outline = [[-0.1, -0.06], [0.1, -0.06], [0.1, 0.06], [-0.1, 0.06]]
+pose = { x = 0.3, y = 0.5, theta = 0.0 }
+mass = 0.1
+support_friction = 0.3
+pusher_friction = 0.5
+[[goals]]
+object = "s"
+pose = { x = 0.7, y = 0.5, theta = 0.0 }
+[stable]
+object = "s"
+goal_xy_frac = 0.25
+goal_theta_deg = 5.0
+edges = [3, 0]
+start_edge = 3
+pusher = { kind = "diff-drive" }
+planner = { a = 1, b = 5, c = 7 }
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("own.toml");
+    std::fs::write(&file, text).unwrap();
+    let task = StableTask::load(file.to_str().unwrap()).unwrap();
+    let p = &task.problem;
+    let edges: Vec<usize> = p.contacts.iter().map(|c| c.edge).collect();
+    assert_eq!(edges, vec![3, 0]);
+    assert_eq!(p.start_contact, Some(0), "edge 3 is the first contact");
+    assert_eq!(p.params.c, Some(7));
+    assert!((p.params.goal_theta - 5f64.to_radians()).abs() < 1e-12);
+    assert_eq!(p.pusher.plate_width, Some(0.1));
+    assert!(!task.plan.steps.is_empty());
+}

@@ -14,7 +14,7 @@ use crate::exec::stable::execute;
 use crate::exec::stable_feedback::{FeedbackParams, execute_closed_loop, plan_inner};
 use crate::planner::stable::presets::{PRESETS, Scene as StableScene, load_scene};
 use crate::planner::stable::robot::{
-    SPEED, robot_problem, robot_problem_edges, robot_problem_in, robot_start, sim_scene,
+    SPEED, robot_problem, robot_problem_in, robot_problem_scene, robot_start, sim_scene,
 };
 use crate::planner::stable::{Plan, Pose, Problem, angle_diff, plan};
 use crate::sim::robot::{SimRobot, SimRobotOptions};
@@ -95,14 +95,9 @@ impl StableTask {
                     s.pusher.kind
                 );
             }
-            let c = s
-                .planner
-                .c
-                .as_ref()
-                .map(|c| c.value())
-                .transpose()?
-                .flatten();
-            robot_problem_edges(name, None, &s.task.edges, c)?
+            // Its whole `[stable]` section: edges, start edge, costs, step, grid, tolerances
+            // and the robot's plate.
+            robot_problem_scene(name)?
         };
         let Some(pl) = plan_inner(&problem).filter(|pl| !pl.steps.is_empty()) else {
             bail!(
