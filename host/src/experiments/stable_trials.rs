@@ -3,10 +3,10 @@
 //! ([`crate::exec::stable::execute`]) or closed loop
 //! ([`crate::exec::stable_feedback::execute_closed_loop`]) on the in-process simulated robot
 //! whose world runs a perturbation drawn from the scene's `[perturb]` ranges
-//! ([`pushbot_sim::perturb`]). `pushbot run stable` and `pushbot eval stable` print them.
+//! (`sim-target/src/perturb.rs`). `pushbot run stable` and `pushbot eval stable` print them.
 
+use crate::sim::target::Perturbation;
 use anyhow::{Context, Result, anyhow, bail};
-use pushbot_sim::perturb::Perturbation;
 use pushbot_world::scene::perturb::Perturb;
 
 use crate::exec::io::RobotIo;

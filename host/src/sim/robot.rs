@@ -89,14 +89,14 @@ impl SimRobot {
     }
 
     /// As [`SimRobot::new`], in the perturbed world `perturb` (issue 21,
-    /// [`pushbot_sim::perturb`]): the simulated world runs its start error, frictions, centre of
+    /// `sim-target/src/perturb.rs`): the simulated world runs its start error, frictions, centre of
     /// friction and wheel slip; the camera noise stays `opts`'s.
     pub fn perturbed(
         mut scene: Scene,
         object_id: Option<&str>,
         start: Option<&str>,
         opts: SimRobotOptions,
-        perturb: Option<pushbot_sim::perturb::Perturbation>,
+        perturb: Option<crate::sim::target::Perturbation>,
     ) -> Result<SimRobot> {
         let object = match object_id {
             Some(id) => scene
