@@ -115,7 +115,7 @@ fn demo_records_and_replay_reproduces_the_tracked_poses() {
     let again = std::fs::read_to_string(dir.path().join("replay/session-1-run.svg"))
         .expect("replayed figure");
     assert_eq!(
-        live.replace("stable pushes executed open loop (truth)", "T"),
+        live.replace("stable pushes executed closed loop (truth)", "T"),
         again.replace("fig15 as recorded", "T")
     );
 }

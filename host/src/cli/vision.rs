@@ -305,7 +305,7 @@ pub fn track(g: &Global, args: TrackArgs) -> CliResult {
         if let Some(rec) = recording.as_mut() {
             // No robot here: the camera's clock is the time line.
             let us = (frame.time.max(0.0) * 1e6) as u64;
-            rec.frame(us, &frame, &r, pipe.calibration())?;
+            rec.frame(us, &frame, &r, pipe.calibration(), None)?;
         }
         let line = TrackLine::from(&r);
         let text = if g.json {

@@ -321,16 +321,15 @@ impl LiveRobot {
         let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
         // The robot stands still while the host looks: its odometry now is its odometry when
         // the frame was taken, and the tracker predicts the primitive's motion from it.
-        if let Some(t) = self.robot.telemetry() {
+        let odometry = self.robot.telemetry().map(|t| {
             let p = t.pose;
+            [f64::from(p.x), f64::from(p.y), f64::from(p.theta)]
+        });
+        if let Some([x, y, theta]) = odometry {
             self.pipeline.odometry(
                 "robot",
                 frame.time,
-                crate::vision::layout::Pose::new(
-                    f64::from(p.x),
-                    f64::from(p.y),
-                    f64::from(p.theta),
-                ),
+                crate::vision::layout::Pose::new(x, y, theta),
             );
         }
         let r = self.pipeline.process(&frame)?;
@@ -341,7 +340,13 @@ impl LiveRobot {
             tracing::warn!("live view: {e:#}");
         }
         if let Some(rec) = &self.recording {
-            rec.look(&self.robot, &frame, &r, self.pipeline.calibration());
+            rec.look(
+                &self.robot,
+                &frame,
+                &r,
+                self.pipeline.calibration(),
+                odometry,
+            );
         }
         for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
             let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);

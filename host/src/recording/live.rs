@@ -40,14 +40,22 @@ impl LiveRecording {
         }
     }
 
-    /// A look: the robot's reports since the last one, then `frame` and its result.
-    pub fn look(&self, robot: &Robot, frame: &Frame, result: &FrameResult, cal: &Calibration) {
+    /// A look: the robot's reports since the last one, then `frame`, the odometry the tracker
+    /// was given with it, and its result.
+    pub fn look(
+        &self,
+        robot: &Robot,
+        frame: &Frame,
+        result: &FrameResult,
+        cal: &Calibration,
+        odometry: Option<[f64; 3]>,
+    ) {
         let now = robot_us(robot);
         self.handle.with(|r| {
             for e in self.events.try_iter() {
                 r.robot_event(&e)?;
             }
-            r.frame(now, frame, result, cal)
+            r.frame(now, frame, result, cal, odometry)
         });
     }
 }

@@ -181,6 +181,17 @@ pub fn replay(contents: &Contents) -> Result<Replay> {
                     .and_then(Value::as_f64)
                     .ok_or_else(|| anyhow!("tracked poses without a frame time"))?;
                 let frame = frame_of(&png, seq, time)?;
+                // The robot's odometry, as the live tracker was given it with this frame.
+                if let Some(o) = m.value.get("odometry").filter(|o| o.is_object()) {
+                    let num = |k: &str| o.get(k).and_then(Value::as_f64);
+                    if let (Some(x), Some(y), Some(theta)) = (num("x"), num("y"), num("theta")) {
+                        l.pipeline.odometry(
+                            "robot",
+                            time,
+                            crate::vision::layout::Pose::new(x, y, theta),
+                        );
+                    }
+                }
                 let r = l.pipeline.process(&frame)?;
                 l.info.frames += 1;
                 compare(&mut l.info, &r, &m.value)?;

@@ -244,7 +244,8 @@ pub fn tracked() -> Value {
     obj(
         "pushbot.TrackedPoses",
         json!({"session": int(), "seq": int(), "frame_time": num(), "full_frame": boolean(),
-               "detections": int(), "bodies": arr(body)}),
+               "detections": int(), "bodies": arr(body),
+               "odometry": obj("pushbot.Odometry", json!({"x": num(), "y": num(), "theta": num()}))}),
     )
 }
 

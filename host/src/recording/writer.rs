@@ -283,6 +283,7 @@ impl Recording {
         frame: &Frame,
         result: &FrameResult,
         cal: &Calibration,
+        odometry: Option<[f64; 3]>,
     ) -> Result<()> {
         let ns = self.at(robot_us);
         let png = png_of(frame)?;
@@ -308,6 +309,9 @@ impl Recording {
             "full_frame": result.full_frame,
             "detections": result.detections.len(),
             "bodies": bodies,
+            // The robot's odometry the tracker was given with this frame, so that a replay
+            // gives it too.
+            "odometry": odometry.map(|[x, y, theta]| json!({"x": x, "y": y, "theta": theta})),
         });
         self.put(topics::TRACKED, ns, &tracked)?;
         for t in result.tracked.iter().filter(|t| t.seen && !t.rejected) {
