@@ -411,3 +411,20 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Scene(cmd) => scene::run(&global, cmd),
     }
 }
+
+/// A progress bar on stderr for `len` steps (hidden with `--json` and off a terminal).
+pub fn progress_bar(global: &Global, len: u64) -> indicatif::ProgressBar {
+    if global.json || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        return indicatif::ProgressBar::hidden();
+    }
+    let pb = indicatif::ProgressBar::with_draw_target(
+        Some(len),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{elapsed_precise} samples {pos} {wide_bar} {msg}")
+    {
+        pb.set_style(style);
+    }
+    pb
+}

@@ -118,7 +118,7 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
             .map_err(|e| CliError::bad_input(format!("--camera {camera}: {e}")))?;
     }
     let trials: Vec<u64> = (r.trial..r.trial + a.trials).collect();
-    let pb = super::strategy_args::progress_bar(g, trials.len() as u64);
+    let pb = super::progress_bar(g, trials.len() as u64);
     pb.set_message(format!(
         "{} {} loop{}",
         r.scene,

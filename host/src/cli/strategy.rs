@@ -6,9 +6,9 @@ use pushbot_world::Scene;
 use serde_json::json;
 
 use super::strategy_args::{
-    BenchArgs, BenchCmd, CollectArgs, DeliveryArgs, EvalArgs, EvalCmd, MethodArg, progress_bar,
+    BenchArgs, BenchCmd, CollectArgs, DeliveryArgs, EvalArgs, EvalCmd, MethodArg,
 };
-use super::{CliError, CliResult, Global, Status};
+use super::{CliError, CliResult, Global, Status, progress_bar};
 use crate::exec::collect::{CollectParams, bring_inside, collect};
 use crate::exec::deliver::{deliver_dipole, deliver_learned};
 use crate::exec::deliver_path::deliver_among_obstacles;

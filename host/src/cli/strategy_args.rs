@@ -2,13 +2,11 @@
 //! learned pushing strategy of Lau, Mitani & Igarashi), shared by the commands that run on a
 //! robot ([`super::strategy`]) and those that run in the simulation (`strategy_sim`).
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use clap::{Args, Subcommand, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::{CliError, Global};
+use super::CliError;
 use crate::exec::deliver::DeliveryParams;
 use crate::strategy::regression::KernelParams;
 
@@ -196,19 +194,6 @@ pub enum BenchCmd {
         #[arg(long, default_value_t = 2_000)]
         queries: usize,
     },
-}
-
-pub fn progress_bar(global: &Global, len: u64) -> ProgressBar {
-    if global.json || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{elapsed_precise} samples {pos} {wide_bar} {msg}")
-    {
-        pb.set_style(style);
-    }
-    pb
 }
 
 impl DeliveryArgs {

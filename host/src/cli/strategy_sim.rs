@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use pushbot_world::Scene;
 use serde_json::json;
 
-use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs, progress_bar};
+use super::progress_bar;
+use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs};
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::experiments::delivery::collect_or_load;
