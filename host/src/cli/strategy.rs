@@ -31,8 +31,11 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
         return Err(CliError::bad_input("--time-limit must be positive"));
     }
     if a.hil {
-        let scene =
-            Scene::preset_or_file(&a.scene).map_err(|e| CliError::bad_input(e.to_string()))?;
+        let name = a
+            .scene
+            .as_deref()
+            .ok_or_else(|| CliError::bad_input("--hil delivers one --scene"))?;
+        let scene = Scene::preset_or_file(name).map_err(|e| CliError::bad_input(e.to_string()))?;
         return run_hil(global, &a, &scene);
     }
     eval_in_sim(global, a)

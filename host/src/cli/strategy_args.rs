@@ -33,6 +33,21 @@ pub struct SimArgs {
     /// Neighbours k of the regression.
     #[arg(long, default_value_t = 5)]
     pub k: usize,
+    /// What the simulated robot sees the table with: `truth` (the simulator's poses with the
+    /// noise above; fast) or `rendered` (frames rendered from the simulated world — lens,
+    /// markers at their heights, blur, noise — read by the host's detector, calibration and
+    /// tracker: the camera in the loop). `--figure 11` defaults to `rendered`.
+    #[arg(long, value_enum)]
+    pub sim_camera: Option<SimCameraArg>,
+}
+
+/// `--sim-camera`: what the simulated robot sees the table with.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimCameraArg {
+    /// The simulator's poses with Gaussian noise.
+    Truth,
+    /// Rendered frames read by the host's vision pipeline.
+    Rendered,
 }
 
 impl SimArgs {
@@ -117,8 +132,14 @@ pub struct DeliveryArgs {
     /// Scene preset or file (e.g. lau-irregular), several separated by commas, or `lau-all`
     /// for the six objects of Lau et al.; scenes with obstacles are delivered along a global
     /// path (learned method).
-    #[arg(long)]
-    pub scene: String,
+    #[arg(long, required_unless_present = "figure")]
+    pub scene: Option<String>,
+    /// Run one of Lau et al.'s evaluations whole and draw it: `11` is Fig. 11 — the six
+    /// objects × starts A–F, learned and dipole side by side, `--trials` each, on all cores,
+    /// with the rendered camera in the loop (unless `--sim-camera truth`); it prints the table
+    /// and writes the figure to `--svg` (default `fig11.svg`).
+    #[arg(long, value_name = "N")]
+    pub figure: Option<u8>,
     /// Object id in the scene (default: the first).
     #[arg(long)]
     pub object: Option<String>,
@@ -167,7 +188,8 @@ pub struct DeliveryArgs {
     /// collection only).
     #[arg(long, default_value_t = 10)]
     pub streak: usize,
-    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG.
+    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG; with
+    /// `--figure`, the figure.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     #[command(flatten)]

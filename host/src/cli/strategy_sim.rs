@@ -8,18 +8,18 @@ use pushbot_world::Scene;
 use serde_json::json;
 
 use super::progress_bar;
-use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs};
+use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs, SimCameraArg};
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::experiments::delivery::collect_or_load;
+use crate::experiments::fig11::{fig11_svg, fig11_table};
 use crate::experiments::strategy_eval::{
-    LAU_SCENES, Method, SceneEval, StartResult, TrialSetup, evaluate_scene, fig11_table,
-    parse_starts,
+    LAU_SCENES, Method, SceneEval, StartResult, TrialSetup, evaluate_scene, parse_starts,
 };
 use crate::planner::global::scene_goal;
-use crate::sim::robot::{SimRobot, SimRobotOptions};
+use crate::sim::robot::{SimCamera, SimRobot, SimRobotOptions};
 use crate::strategy::figures;
-use crate::strategy::regression::PushStrategy;
+use crate::strategy::regression::{KernelParams, PushStrategy};
 use crate::strategy::sample::Sample;
 use crate::strategy::store::{self, StrategyWriter};
 
@@ -63,25 +63,36 @@ impl SimArgs {
             heading_noise: self.noise_deg.to_radians(),
             boundary_inset,
             table_margin: self.table_margin,
+            camera: match self.sim_camera {
+                Some(SimCameraArg::Rendered) => SimCamera::Rendered,
+                Some(SimCameraArg::Truth) | None => SimCamera::Truth,
+            },
             ..SimRobotOptions::default()
         })
     }
 }
 
-/// Collect in the simulation into `writer`'s file, starting from `existing` samples.
+/// Collect in the simulation into `writer`'s file, starting from `existing` samples, with a
+/// progress bar unless `quiet`.
+#[allow(clippy::too_many_arguments)]
 fn collect_in_sim(
     global: &Global,
     scene: Scene,
     object: Option<&str>,
-    sim: &SimArgs,
+    opts: SimRobotOptions,
+    kernel: KernelParams,
     params: &CollectParams,
     existing: Vec<Sample>,
     writer: Option<&mut StrategyWriter>,
+    quiet: bool,
 ) -> Result<(PushStrategy, CollectReport), CliError> {
-    let mut io = SimRobot::new(scene, object, None, sim.options(global.seed)?)
-        .map_err(CliError::BadInput)?;
-    let mut strategy = PushStrategy::new(existing, sim.kernel()?);
-    let pb = progress_bar(global, params.initial as u64);
+    let mut io = SimRobot::new(scene, object, None, opts).map_err(CliError::BadInput)?;
+    let mut strategy = PushStrategy::new(existing, kernel);
+    let pb = if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        progress_bar(global, params.initial as u64)
+    };
     let mut w = writer;
     let mut sink = |s: &Sample| -> anyhow::Result<()> {
         if let Some(w) = w.as_deref_mut() {
@@ -116,10 +127,12 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
         global,
         scene,
         id.as_deref(),
-        &a.sim,
+        a.sim.options(global.seed)?,
+        a.sim.kernel()?,
         &params,
         existing,
         Some(&mut writer),
+        false,
     )?;
     if let Some(svg) = &a.svg {
         std::fs::write(svg, figures::strategy_svg(strategy.samples(), &outline))
@@ -159,13 +172,95 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
     })
 }
 
-/// `pushbot eval delivery` on simulated trials.
-pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
+/// The strategy `eval delivery` runs in `scene` (`name` as given): from `--strategy`, from
+/// `--strategy-dir` (collected there when missing), or collected here first on the scene's
+/// table without its obstacles; and the collection's report when it collected. `quiet` hides
+/// the progress bar (scenes collected side by side).
+fn strategy_for(
+    global: &Global,
+    a: &DeliveryArgs,
+    name: &str,
+    scene: &Scene,
+    setup: &TrialSetup,
+    quiet: bool,
+) -> Result<(Vec<Sample>, Option<CollectReport>), CliError> {
+    let params = CollectParams {
+        initial: a.initial,
+        streak: a.streak,
+        seed: global.seed,
+        ..CollectParams::default()
+    };
+    if let Some(path) = &a.strategy {
+        let samples = store::load(path)
+            .map_err(|e| CliError::bad_input(e.to_string()))?
+            .samples;
+        return Ok((samples, None));
+    }
+    if let Some(dir) = &a.strategy_dir {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::bad_input(format!("cannot create {}: {e}", dir.display())))?;
+        let file = dir.join(format!("{}.strategy", name.replace(['/', '.'], "_")));
+        let pb = if quiet {
+            indicatif::ProgressBar::hidden()
+        } else {
+            progress_bar(global, params.initial as u64)
+        };
+        let (samples, rep) = collect_or_load(
+            scene,
+            a.object.as_deref(),
+            &file,
+            setup.sim,
+            &params,
+            setup.kernel,
+            &pb,
+        )
+        .map_err(CliError::Failed)?;
+        pb.finish_and_clear();
+        return Ok((samples, rep));
+    }
+    let mut clear = scene.clone();
+    clear.obstacles.clear();
+    let (strategy, rep) = collect_in_sim(
+        global,
+        clear,
+        a.object.as_deref(),
+        setup.sim,
+        setup.kernel,
+        &params,
+        Vec::new(),
+        None,
+        quiet,
+    )?;
+    Ok((strategy.samples().to_vec(), Some(rep)))
+}
+
+/// `pushbot eval delivery` on simulated trials; with `--figure 11`, Lau et al.'s Fig. 11 whole.
+pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
+    use rayon::prelude::*;
+    match (a.figure, a.scene.as_deref()) {
+        (None, _) => {}
+        (Some(11), None | Some("lau-all")) => {
+            a.scene = Some("lau-all".into());
+            a.sim.sim_camera.get_or_insert(SimCameraArg::Rendered);
+            a.svg.get_or_insert_with(|| PathBuf::from("fig11.svg"));
+        }
+        (Some(11), Some(s)) => {
+            return Err(CliError::bad_input(format!(
+                "--figure 11 runs Lau et al.'s six objects; it takes no --scene ({s})"
+            )));
+        }
+        (Some(n), _) => {
+            return Err(CliError::bad_input(format!(
+                "--figure {n}: this command draws Lau et al.'s Fig. 11 (--figure 11)"
+            )));
+        }
+    }
     let starts = parse_starts(&a.start).map_err(CliError::bad_input)?;
-    let names: Vec<String> = if a.scene.trim() == "lau-all" {
+    let scene_arg = a.scene.clone().unwrap_or_default();
+    let names: Vec<String> = if scene_arg.trim() == "lau-all" {
         LAU_SCENES.iter().map(|s| (*s).to_owned()).collect()
     } else {
-        a.scene
+        scene_arg
             .split(',')
             .map(|s| s.trim().to_owned())
             .filter(|s| !s.is_empty())
@@ -179,7 +274,7 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
             "--strategy is one file for one scene; use --strategy-dir with several scenes",
         ));
     }
-    let mut scenes = Vec::new();
+    let mut setups = Vec::new();
     for n in &names {
         let scene = Scene::preset_or_file(n).map_err(|e| CliError::bad_input(e.to_string()))?;
         for s in &starts {
@@ -190,98 +285,62 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
                 )));
             }
         }
-        scenes.push(scene);
-    }
-    let methods: Vec<Method> = match a.method {
-        MethodArg::Learned => vec![Method::Learned],
-        MethodArg::Dipole => vec![Method::Dipole],
-        MethodArg::Both => vec![Method::Dipole, Method::Learned],
-    };
-    let mut evals = Vec::new();
-    let mut trajectories = Vec::new();
-    for (name, scene) in names.iter().zip(&scenes) {
         let setup = TrialSetup {
-            scene: scene.clone(),
+            scene,
             object: a.object.clone(),
             sim: a.sim.options(global.seed)?,
             delivery: a.delivery_params()?,
             kernel: a.sim.kernel()?,
         };
         setup.goal().map_err(CliError::BadInput)?;
-        // The strategy: from a file, from the cache directory (collected there when missing),
-        // or collected here first.
-        let params = CollectParams {
-            initial: a.initial,
-            streak: a.streak,
-            seed: global.seed,
-            ..CollectParams::default()
+        setups.push(setup);
+    }
+    if a.svg.is_some() && a.figure.is_none() && setups.len() != 1 {
+        return Err(CliError::bad_input("--svg draws one scene's trajectories"));
+    }
+    let methods: Vec<Method> = match a.method {
+        MethodArg::Learned => vec![Method::Learned],
+        MethodArg::Dipole => vec![Method::Dipole],
+        MethodArg::Both => vec![Method::Dipole, Method::Learned],
+    };
+    // The strategies, every scene's on its own core.
+    let several = setups.len() > 1;
+    let strategies = names
+        .par_iter()
+        .zip(&setups)
+        .map(|(name, setup)| {
+            if !methods.contains(&Method::Learned) {
+                return Ok((Vec::new(), None));
+            }
+            strategy_for(global, &a, name, &setup.scene, setup, several)
+        })
+        .collect::<Result<Vec<_>, CliError>>()?;
+    let total = (setups.len() * starts.len() * methods.len() * a.trials) as u64;
+    let pb = progress_bar(global, total);
+    let mut evals = Vec::new();
+    let mut trajectories = Vec::new();
+    for (setup, (samples, collection)) in setups.iter().zip(strategies) {
+        let scene = &setup.scene;
+        let report = |res: &StartResult| {
+            pb.inc(res.trials as u64);
+            if !global.json {
+                pb.println(format!(
+                    "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?} | stalls recovered {}",
+                    scene.name,
+                    res.start,
+                    format!("{:?}", res.method),
+                    res.success_rate,
+                    res.trials,
+                    res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
+                    res.mean_object_path_m.map_or("-".into(), |t| format!("{t:.2} m")),
+                    res.failures,
+                    res.stall_recoveries,
+                ));
+            }
         };
-        let mut collection = None;
-        let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
-            Vec::new()
-        } else if let Some(path) = &a.strategy {
-            store::load(path)
-                .map_err(|e| CliError::bad_input(e.to_string()))?
-                .samples
-        } else if let Some(dir) = &a.strategy_dir {
-            std::fs::create_dir_all(dir).map_err(|e| {
-                CliError::bad_input(format!("cannot create {}: {e}", dir.display()))
-            })?;
-            let file = dir.join(format!("{}.strategy", name.replace(['/', '.'], "_")));
-            let pb = progress_bar(global, params.initial as u64);
-            let (samples, rep) = collect_or_load(
-                scene,
-                a.object.as_deref(),
-                &file,
-                setup.sim,
-                &params,
-                setup.kernel,
-                &pb,
-            )
-            .map_err(CliError::Failed)?;
-            pb.finish_and_clear();
-            collection = rep;
-            samples
-        } else {
-            let mut clear = scene.clone();
-            clear.obstacles.clear();
-            let (strat, rep) = collect_in_sim(
-                global,
-                clear,
-                a.object.as_deref(),
-                &a.sim,
-                &params,
-                Vec::new(),
-                None,
-            )?;
-            collection = Some(rep);
-            strat.samples().to_vec()
-        };
-        let (results, runs) = evaluate_scene(
-            &setup,
-            &methods,
-            &samples,
-            &starts,
-            a.trials,
-            &mut |res: &StartResult| {
-                if !global.json {
-                    println!(
-                        "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?} | stalls recovered {}",
-                        scene.name,
-                        res.start,
-                        format!("{:?}", res.method),
-                        res.success_rate,
-                        res.trials,
-                        res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
-                        res.mean_object_path_m
-                            .map_or("-".into(), |t| format!("{t:.2} m")),
-                        res.failures,
-                        res.stall_recoveries,
-                    );
-                }
-            },
-        )?;
-        if names.len() == 1 {
+        let (results, runs) =
+            evaluate_scene(setup, &methods, &samples, &starts, a.trials, &report)?;
+        if !several {
             trajectories.extend(runs);
         }
         evals.push(SceneEval {
@@ -291,14 +350,27 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
             results,
         });
     }
+    pb.finish_and_clear();
+    let camera = match a.sim.sim_camera {
+        Some(SimCameraArg::Rendered) => "the rendered camera in the loop",
+        _ => "the simulator's poses with camera noise",
+    };
     if let Some(svg) = &a.svg {
-        if let [scene] = scenes.as_slice() {
-            let goal = scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
-            let text = figures::trajectories_svg(&trajectories, scene, goal);
-            std::fs::write(svg, text)
-                .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
+        let text = if a.figure.is_some() {
+            let caption = format!(
+                "{} trials per bar, seed {}, {camera}; `pushbot eval delivery --figure 11 --trials {} --seed {}`",
+                a.trials, global.seed, a.trials, global.seed
+            );
+            fig11_svg(&evals, &starts, &methods, &caption)
         } else {
-            return Err(CliError::bad_input("--svg draws one scene's trajectories"));
+            let scene = &setups[0].scene;
+            let goal = scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
+            figures::trajectories_svg(&trajectories, scene, goal)
+        };
+        std::fs::write(svg, &text)
+            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
+        if a.figure.is_some() {
+            crate::plot::svg_to_png(&text, &svg.with_extension("png")).map_err(CliError::Failed)?;
         }
     }
     let learned_ok = evals
@@ -312,12 +384,27 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
             json!({
                 "trials": a.trials,
                 "starts": starts,
+                "camera": a.sim.sim_camera.map_or("truth", |c| match c {
+                    SimCameraArg::Rendered => "rendered",
+                    SimCameraArg::Truth => "truth",
+                }),
+                "figure": a.svg.as_ref().filter(|_| a.figure.is_some()),
                 "scenes": evals,
             })
         );
     } else {
-        println!("\nSuccess % of {} trials (Lau et al. Fig. 11):", a.trials);
+        println!(
+            "\nSuccess % of {} trials (Lau et al. Fig. 11), {camera}:",
+            a.trials
+        );
         print!("{}", fig11_table(&evals, &starts, &methods));
+        if let (Some(_), Some(svg)) = (a.figure, &a.svg) {
+            println!(
+                "figure written to {} and {}",
+                svg.display(),
+                svg.with_extension("png").display()
+            );
+        }
     }
     Ok(if learned_ok {
         Status::Success

@@ -5,6 +5,7 @@
 //! - [`trials`]: statistics of delivery trials (Lau et al. §V, Fig. 11), for any robot.
 //! - `strategy_eval`: delivery trials of the learned strategy and the dipole field from the
 //!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
+//! - `fig11`: Lau et al. Fig. 11's table and figure from those trials.
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
 //! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
@@ -18,6 +19,8 @@
 pub mod delivery;
 #[cfg(feature = "sim")]
 pub mod demo;
+#[cfg(feature = "sim")]
+pub mod fig11;
 #[cfg(feature = "sim")]
 pub mod link_bench;
 pub mod rearrange_bench;

@@ -145,72 +145,44 @@ pub struct SceneEval {
     pub results: Vec<StartResult>,
 }
 
-/// The table of Lau et al. Fig. 11: success % per start (rows) and scene × method (columns).
-pub fn fig11_table(evals: &[SceneEval], starts: &[String], methods: &[Method]) -> String {
-    use std::fmt::Write;
-    let mut t = String::new();
-    let short = |s: &str| s.strip_prefix("lau-").unwrap_or(s).to_owned();
-    let name = |m: &Method| match m {
-        Method::Learned => "ours",
-        Method::Dipole => "dipole",
-    };
-    let _ = write!(t, "{:<6}", "start");
-    for e in evals {
-        let w = 9 * methods.len();
-        let _ = write!(t, "| {:<w$}", short(&e.scene));
-    }
-    t.push('\n');
-    let _ = write!(t, "{:<6}", "");
-    for _ in evals {
-        t.push_str("| ");
-        for m in methods {
-            let _ = write!(t, "{:<9}", name(m));
-        }
-    }
-    t.push('\n');
-    for s in starts {
-        let _ = write!(t, "{s:<6}");
-        for e in evals {
-            t.push_str("| ");
-            for m in methods {
-                let cell = e
-                    .results
-                    .iter()
-                    .find(|r| &r.start == s && r.method == *m)
-                    .map_or("-".to_owned(), |r| format!("{:.0}", r.success_rate));
-                let _ = write!(t, "{cell:<9}");
-            }
-        }
-        t.push('\n');
-    }
-    t
-}
-
 /// One trial's robot and object poses after every step, labelled "START METHOD".
 pub type LabelledRun = (String, Vec<(Pose2, Pose2)>);
 
-/// Trials of every method from every start of one scene (Lau et al. §V): the results, in the
-/// order start × method, each handed to `report` as it is done, and the first trial's
-/// trajectory of each (labelled "START METHOD") for the figure.
+/// Trials of every method from every start of one scene (Lau et al. §V), the cells (start ×
+/// method) on all cores: the results in the order start × method, each handed to `report` as
+/// its cell is done (in any order), and the first trial's trajectory of each (labelled "START
+/// METHOD") for the figure.
 pub fn evaluate_scene(
     setup: &TrialSetup,
     methods: &[Method],
     samples: &[Sample],
     starts: &[String],
     trials: usize,
-    report: &mut dyn FnMut(&StartResult),
+    report: &(dyn Fn(&StartResult) + Sync),
 ) -> Result<(Vec<StartResult>, Vec<LabelledRun>)> {
-    let mut results = Vec::new();
-    let mut trajectories = Vec::new();
-    for s in starts {
-        for &m in methods {
-            let (res, runs) = run_start(setup, m, samples, s, trials)?;
-            if let Some(first) = runs.into_iter().next() {
-                trajectories.push((format!("{s} {m:?}"), first.trajectory));
-            }
+    use rayon::prelude::*;
+    let cells: Vec<(&String, Method)> = starts
+        .iter()
+        .flat_map(|s| methods.iter().map(move |m| (s, *m)))
+        .collect();
+    let done = cells
+        .par_iter()
+        .map(|(s, m)| {
+            let (res, runs) = run_start(setup, *m, samples, s, trials)?;
             report(&res);
-            results.push(res);
-        }
+            Ok((
+                res,
+                runs.into_iter()
+                    .next()
+                    .map(|first| (format!("{s} {m:?}"), first.trajectory)),
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut results = Vec::with_capacity(done.len());
+    let mut trajectories = Vec::new();
+    for (res, first) in done {
+        results.push(res);
+        trajectories.extend(first);
     }
     Ok((results, trajectories))
 }

@@ -13,6 +13,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
+use super::camera::{REACQUIRE_FRAMES, RenderedCamera};
 use super::inprocess::{InProcess, SimRef};
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::link::{LinkError, Refusal};
@@ -43,6 +44,22 @@ pub struct SimRobotOptions {
     /// snake) pushed against the wall could not be pushed back. Observations stay in the
     /// scene's coordinates.
     pub table_margin: f64,
+    /// What the robot sees the table with: the simulator's truth with the noise above, or the
+    /// rendered camera read by the host's vision pipeline ([`super::camera`]).
+    pub camera: SimCamera,
+}
+
+/// The in-process robot's camera.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SimCamera {
+    /// The simulator's true poses with seeded Gaussian noise (`position_noise`,
+    /// `heading_noise`): fast, for long evaluations.
+    #[default]
+    Truth,
+    /// Frames rendered from the simulated world (lens, marker heights, blur, noise) and read by
+    /// the host's detector, calibration and tracker: the camera in the loop.
+    Rendered,
 }
 
 impl Default for SimRobotOptions {
@@ -55,6 +72,7 @@ impl Default for SimRobotOptions {
             spin_rate: 3.0,
             boundary_inset: 0.1,
             table_margin: 0.25,
+            camera: SimCamera::Truth,
         }
     }
 }
@@ -68,7 +86,22 @@ pub struct SimRobot {
     marker: [f64; 2],
     workspace: Workspace,
     margin: f64,
+    /// The rendered camera, with [`SimCamera::Rendered`].
+    camera: Option<RenderedCamera>,
+    /// Whether the rendered camera looked since the last motion.
+    fresh: bool,
+    /// Simulated time of the latest look.
+    look_from: f64,
+    /// Why the camera lost a body: the next motion fails with it, as on the live robot.
+    camera_error: Option<String>,
 }
+
+/// What a body never seen measures.
+const NAN_POSE: Pose2 = Pose2 {
+    x: f64::NAN,
+    y: f64::NAN,
+    theta: f64::NAN,
+};
 
 /// Longest the simulated robot may stay silent (a primitive that never ends: telemetry is off),
 /// s of simulated time.
@@ -153,6 +186,7 @@ impl SimRobot {
             dead_link_timeout: Duration::from_secs(PRIMITIVE_LIMIT_S),
             ..LinkOptions::default()
         };
+        let camera_scene = (opts.camera == SimCamera::Rendered).then(|| scene.clone());
         let driver = InProcess::start_perturbed(scene, opts.seed, perturb, link.client_options(1))?;
         let robot = Robot::over(driver, link)
             .map_err(|e| anyhow!("the simulated robot refused the session: {e}"))?;
@@ -164,6 +198,14 @@ impl SimRobot {
         robot
             .configure(cfg)
             .map_err(|e| anyhow!("the simulated robot refused the configuration: {e}"))?;
+        let camera = match camera_scene {
+            Some(scene) => Some(RenderedCamera::new(
+                &scene,
+                opts.seed,
+                &robot.driver().sim(),
+            )?),
+            None => None,
+        };
         Ok(SimRobot {
             robot,
             opts,
@@ -172,6 +214,10 @@ impl SimRobot {
             marker,
             workspace,
             margin: m,
+            camera,
+            fresh: false,
+            look_from: f64::NEG_INFINITY,
+            camera_error: None,
         })
     }
 
@@ -205,6 +251,10 @@ impl SimRobot {
     /// Run one motion command to its `Done`; a latched fault (a stall against something that
     /// does not move) is cleared and the motion counts as ended.
     fn motion(&mut self, cmd: Command) -> Result<()> {
+        if let Some(e) = &self.camera_error {
+            bail!("{e}");
+        }
+        self.fresh = false;
         for attempt in 0..2 {
             let started = match self.robot.start(cmd) {
                 Ok(m) => m,
@@ -242,6 +292,51 @@ impl SimRobot {
             }
         }
         bail!("faults {:?} would not clear", self.sim().truth().faults)
+    }
+
+    /// What the rendered camera makes of `body` now (the scene's coordinates): one look per
+    /// stop, and while `body` is not in it, one more frame at a time up to
+    /// [`REACQUIRE_FRAMES`] (the robot stands still meanwhile); still unseen, it is lost and
+    /// the next motion fails. `None` without the rendered camera or for a body never seen.
+    fn seen(&mut self, body: &str) -> Option<Pose2> {
+        let cam = self.camera.as_mut()?;
+        let driver = self.robot.driver();
+        if !self.fresh && self.camera_error.is_none() {
+            self.look_from = driver.sim().now_us() as f64 * 1e-6;
+            if let Err(e) = cam.look(&driver.sim(), &[]) {
+                self.camera_error = Some(format!("camera: {e:#}"));
+            }
+            self.fresh = true;
+        }
+        let stale = |cam: &RenderedCamera| cam.pose(body).is_none_or(|(_, t)| t < self.look_from);
+        if self.camera_error.is_none() && stale(cam) {
+            for _ in 0..REACQUIRE_FRAMES {
+                driver.run_for(cam.period());
+                match cam.look(&driver.sim(), &[body]) {
+                    Ok(true) => break,
+                    Ok(false) => {}
+                    Err(e) => {
+                        self.camera_error = Some(format!("camera: {e:#}"));
+                        break;
+                    }
+                }
+            }
+            if stale(cam) && self.camera_error.is_none() {
+                tracing::warn!("{body} lost");
+                self.camera_error = Some(format!(
+                    "{body} is lost: the rendered camera has not seen its marker in {} frames \
+                     since the robot stopped",
+                    REACQUIRE_FRAMES + 1
+                ));
+            }
+        }
+        let (p, _) = cam.pose(body)?;
+        Some(Pose2::new(p.x - self.margin, p.y - self.margin, p.theta))
+    }
+
+    /// Frames the rendered camera has read (0 without it).
+    pub fn camera_frames(&self) -> u64 {
+        self.camera.as_ref().map_or(0, RenderedCamera::frames)
     }
 
     fn noisy(&mut self, p: Pose2) -> Pose2 {
@@ -314,16 +409,34 @@ impl RobotIo for SimRobot {
     }
 
     fn robot_pose(&mut self) -> Pose2 {
+        if self.camera.is_some() {
+            return self.seen("robot").unwrap_or(NAN_POSE);
+        }
         let p = self.true_robot_pose();
         self.noisy(p)
     }
 
     fn object_pose(&mut self) -> Pose2 {
+        if self.camera.is_some() {
+            let id = self
+                .sim()
+                .object_poses()
+                .get(self.object)
+                .map(|(id, _)| id.clone());
+            let Some(body) = id.and_then(|id| self.seen(&id)) else {
+                return NAN_POSE;
+            };
+            let m = body.point_to_world(Vector2::new(self.marker[0], self.marker[1]));
+            return Pose2::new(m.x, m.y, body.theta);
+        }
         let p = self.true_object_pose();
         self.noisy(p)
     }
 
     fn body_pose(&mut self, id: &str) -> Option<Pose2> {
+        if self.camera.is_some() {
+            return self.seen(id);
+        }
         let (_, p) = self
             .sim()
             .object_poses()
@@ -373,5 +486,37 @@ mod tests {
         let o = r.object_pose();
         assert!((o.x - 0.45).abs() < 1e-9 && (o.y - 0.25).abs() < 1e-9);
         assert!(r.time() > 1.0);
+    }
+
+    #[test]
+    fn the_rendered_camera_sees_what_the_simulator_holds() {
+        let scene = Scene::preset("lau-irregular").unwrap();
+        let opts = SimRobotOptions {
+            camera: SimCamera::Rendered,
+            ..SimRobotOptions::default()
+        };
+        let mut r = SimRobot::new(scene, None, Some("C"), opts).unwrap();
+        for step in 0..3 {
+            let (seen, truth) = (r.robot_pose(), r.true_robot_pose());
+            let err = (seen.x - truth.x).hypot(seen.y - truth.y);
+            assert!(
+                err < 0.005,
+                "step {step}: robot seen {seen:?}, truly {truth:?}"
+            );
+            assert!(wrap_angle(seen.theta - truth.theta).abs() < 2f64.to_radians());
+            let (seen, truth) = (r.object_pose(), r.true_object_pose());
+            let err = (seen.x - truth.x).hypot(seen.y - truth.y);
+            assert!(
+                err < 0.005,
+                "step {step}: object seen {seen:?}, truly {truth:?}"
+            );
+            // The same stop is one look: asking again reads no new frame.
+            let frames = r.camera_frames();
+            r.robot_pose();
+            assert_eq!(r.camera_frames(), frames);
+            r.spin(0.6).unwrap();
+            r.forward(0.08).unwrap();
+        }
+        assert!(r.camera_frames() >= 3);
     }
 }
