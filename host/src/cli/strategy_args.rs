@@ -188,8 +188,8 @@ pub struct DeliveryArgs {
     /// collection only).
     #[arg(long, default_value_t = 10)]
     pub streak: usize,
-    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG; with
-    /// `--figure`, the figure.
+    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG, and a PNG
+    /// of it beside; with `--figure`, the figure.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     #[command(flatten)]

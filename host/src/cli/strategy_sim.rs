@@ -324,18 +324,29 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
         let report = |res: &StartResult| {
             pb.inc(res.trials as u64);
             if !global.json {
-                pb.println(format!(
-                    "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} | failures {:?} | stalls recovered {}",
+                let line = format!(
+                    "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} ({} shortest, worst {}) | failures {:?} | stalls recovered {}",
                     scene.name,
                     res.start,
                     format!("{:?}", res.method),
                     res.success_rate,
                     res.trials,
                     res.mean_time_s.map_or("-".into(), |t| format!("{t:.1} s")),
-                    res.mean_object_path_m.map_or("-".into(), |t| format!("{t:.2} m")),
+                    res.mean_object_path_m
+                        .map_or("-".into(), |t| format!("{t:.2} m")),
+                    res.mean_path_ratio
+                        .map_or("-".into(), |t| format!("{t:.2}×")),
+                    res.max_path_ratio
+                        .map_or("-".into(), |t| format!("{t:.2}×")),
                     res.failures,
                     res.stall_recoveries,
-                ));
+                );
+                // A hidden bar (output not a terminal) prints nothing.
+                if pb.is_hidden() {
+                    println!("{line}");
+                } else {
+                    pb.println(line);
+                }
             }
         };
         let (results, runs) =
@@ -369,9 +380,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
         };
         std::fs::write(svg, &text)
             .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
-        if a.figure.is_some() {
-            crate::plot::svg_to_png(&text, &svg.with_extension("png")).map_err(CliError::Failed)?;
-        }
+        crate::plot::svg_to_png(&text, &svg.with_extension("png")).map_err(CliError::Failed)?;
     }
     let learned_ok = evals
         .iter()

@@ -130,6 +130,10 @@ pub struct Delivery {
     pub object_path: f64,
     /// Path length of the robot, m.
     pub robot_path: f64,
+    /// Length of the shortest collision-free path of the object's marker from where it
+    /// started to the goal, m, when measured
+    /// ([`crate::planner::global::shortest_object_path`]).
+    pub shortest_path: Option<f64>,
     /// Final marker–goal distance, m.
     pub final_distance: f64,
     /// Robot and object poses after every step (Fig. 8).
@@ -249,6 +253,7 @@ fn finish(
         recoveries: Vec::new(),
         object_path: path_len(&trajectory, |t| t.1),
         robot_path: path_len(&trajectory, |t| t.0),
+        shortest_path: None,
         final_distance: (goal - o.position()).norm(),
         trajectory,
     }

@@ -18,7 +18,7 @@ use crate::exec::deliver::{Delivery, DeliveryParams, Failure, Recovery, deliver_
 use crate::exec::io::RobotIo;
 use crate::exec::io::Workspace;
 use crate::planner::global::{
-    ObstacleParams, clearance, plan_object_path, point_along, robot_fits,
+    ObstacleParams, clearance, path_length, plan_object_path, point_along, robot_fits,
 };
 use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::Sample;
@@ -56,6 +56,7 @@ pub fn deliver_among_obstacles(
         recoveries: Vec::new(),
         object_path: 0.0,
         robot_path: 0.0,
+        shortest_path: None,
         final_distance: f64::NAN,
         trajectory: Vec::new(),
     };
@@ -77,7 +78,7 @@ pub fn deliver_among_obstacles(
         if first_path.is_empty() {
             first_path = shown;
         }
-        let length: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let length = path_length(&path);
         let last = length <= spacing * 1.5;
         let sub = if last {
             goal

@@ -162,6 +162,8 @@ mod tests {
             mean_time_s: None,
             mean_object_path_m: None,
             mean_robot_path_m: None,
+            mean_path_ratio: None,
+            max_path_ratio: None,
             failures: Default::default(),
             stall_recoveries: 0,
         }

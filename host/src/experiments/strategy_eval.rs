@@ -11,7 +11,7 @@ use crate::exec::collect::CollectReport;
 use crate::exec::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use crate::exec::deliver_path::deliver_among_obstacles;
 use crate::exec::io::RobotIo;
-use crate::planner::global::{ObstacleParams, scene_obstacles};
+use crate::planner::global::{ObstacleParams, path_length, scene_obstacles, shortest_object_path};
 use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::regression::{KernelParams, PushStrategy};
 use crate::strategy::sample::{Pose2, Sample};
@@ -97,14 +97,23 @@ pub fn run_start(
                 ws.boundary.max[1]
             );
         }
-        let d = match method {
+        let obstacles = scene_obstacles(&setup.scene);
+        let shortest = shortest_object_path(
+            &ws,
+            &obstacles,
+            o.position(),
+            goal,
+            &ObstacleParams::default(),
+        )
+        .map(|p| path_length(&p));
+        let mut d = match method {
             Method::Learned if !setup.scene.obstacles.is_empty() => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
                 deliver_among_obstacles(
                     &mut io,
                     &mut strat,
                     goal,
-                    &scene_obstacles(&setup.scene),
+                    &obstacles,
                     &setup.delivery,
                     &ObstacleParams::default(),
                     &mut |_| Ok(()),
@@ -117,6 +126,7 @@ pub fn run_start(
             }
             Method::Dipole => deliver_dipole(&mut io, goal, &setup.delivery)?,
         };
+        d.shortest_path = shortest;
         runs.push(d);
     }
     Ok((summarise(start, method, &runs), runs))

@@ -35,6 +35,11 @@ pub struct StartResult {
     pub mean_object_path_m: Option<f64>,
     /// Mean robot path length of the successful trials, m.
     pub mean_robot_path_m: Option<f64>,
+    /// Mean, over the successful trials, of the object's path length over the shortest
+    /// collision-free path of its marker from its start to the goal.
+    pub mean_path_ratio: Option<f64>,
+    /// Largest of those ratios.
+    pub max_path_ratio: Option<f64>,
     /// Failures by reason.
     pub failures: BTreeMap<String, usize>,
     /// Stalls recovered from (or given up on) over all trials (deliveries among obstacles).
@@ -49,6 +54,14 @@ fn mean(xs: impl Iterator<Item = f64>) -> Option<f64> {
 /// Success rate, means over successful trials, failures by reason.
 pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult {
     let ok: Vec<&Delivery> = runs.iter().filter(|d| d.success).collect();
+    let ratios: Vec<f64> = ok
+        .iter()
+        .filter_map(|d| {
+            d.shortest_path
+                .filter(|s| *s > 0.01)
+                .map(|s| d.object_path / s)
+        })
+        .collect();
     let mut failures = BTreeMap::new();
     for d in runs {
         if let Some(f) = d.failure {
@@ -72,6 +85,8 @@ pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult 
         mean_time_s: mean(ok.iter().map(|d| d.time)),
         mean_object_path_m: mean(ok.iter().map(|d| d.object_path)),
         mean_robot_path_m: mean(ok.iter().map(|d| d.robot_path)),
+        mean_path_ratio: mean(ratios.iter().copied()),
+        max_path_ratio: ratios.iter().copied().reduce(f64::max),
         failures,
         stall_recoveries: runs.iter().map(|d| d.recoveries.len()).sum(),
     }

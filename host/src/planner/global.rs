@@ -297,19 +297,61 @@ pub fn plan_robot_path(
         ..ObstacleParams::default()
     };
     let path = plan_object_path(&disc, obstacles, start, goal, &op)?;
-    // Keep a way point only where the straight way from the last one kept is blocked.
-    let mut out = vec![start];
+    Some(pull_taut(&path, |a, b| segment_clear(ws, obstacles, a, b)))
+}
+
+/// The shortest collision-free path of the object's marker from `start` to `goal`: its
+/// bounding circle (around the marker) clear of every obstacle by `op.object_margin` and the
+/// marker inside the boundary, with no regard for the robot's room — the yardstick the
+/// delivered path is measured against. A* on the grid, then pulled taut (a way point kept only
+/// where the straight way from the previous one is blocked). `None` when there is none.
+pub fn shortest_object_path(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    start: Vector2<f64>,
+    goal: Vector2<f64>,
+    op: &ObstacleParams,
+) -> Option<Vec<Vector2<f64>>> {
+    let free = ObstacleParams {
+        room_penalty: 1,
+        behind_penalty: 1,
+        ..*op
+    };
+    let path = plan_object_path(ws, obstacles, start, goal, &free)?;
+    let keep = ws.object_radius + op.object_margin;
+    let fits = |p: Vector2<f64>| ws.boundary.contains(p) && clearance(p, obstacles) >= keep;
+    Some(pull_taut(&path, |a, b| {
+        let n = ((b - a).norm() / 0.005).ceil().max(1.0) as usize;
+        (0..=n).all(|k| fits(a + (b - a) * (k as f64 / n as f64)))
+    }))
+}
+
+/// Length of a path, m.
+pub fn path_length(path: &[Vector2<f64>]) -> f64 {
+    path.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// `path` with a way point kept only where the straight way (`clear`) from the last one kept
+/// to the next is blocked; its ends stay.
+fn pull_taut(
+    path: &[Vector2<f64>],
+    clear: impl Fn(Vector2<f64>, Vector2<f64>) -> bool,
+) -> Vec<Vector2<f64>> {
+    let Some(&first) = path.first() else {
+        return Vec::new();
+    };
+    let mut out = vec![first];
     let mut i = 0;
     while i + 1 < path.len() {
         let from = out[out.len() - 1];
         let mut j = i + 1;
-        while j + 1 < path.len() && segment_clear(ws, obstacles, from, path[j + 1]) {
+        while j + 1 < path.len() && clear(from, path[j + 1]) {
             j += 1;
         }
         out.push(path[j]);
         i = j;
     }
-    Some(out)
+    out
 }
 
 /// The scene's obstacles as polygons.
@@ -473,5 +515,36 @@ mod tests {
             assert!(segment_clear(&ws, &wall, w[0], w[1]), "{w:?}");
         }
         assert!(path.iter().any(|q| q.y < 0.45), "{path:?}");
+    }
+
+    /// On a clear table the shortest path is the straight line; round a wall it is the taut
+    /// string past the wall's end (at the object's clearance), shorter than the grid's path
+    /// and than the delivery's path (which pays for the robot's room), and no shorter than the
+    /// two straight legs through the corner it bends at.
+    #[test]
+    fn the_shortest_path_is_the_taut_string_round_the_wall() {
+        let ws = ws();
+        let p = ObstacleParams::default();
+        let (s, g) = (Vector2::new(0.45, 0.95), Vector2::new(1.25, 0.6));
+        let straight = shortest_object_path(&ws, &[], s, g, &p).unwrap();
+        assert_eq!(straight, vec![s, g]);
+        let wall = vec![rect(0.78, 0.45, 0.88, 1.2)];
+        let taut = shortest_object_path(&ws, &wall, s, g, &p).unwrap();
+        let grid = plan_object_path(&ws, &wall, s, g, &p).unwrap();
+        assert!(taut.len() >= 3 && taut.len() < grid.len() / 4, "{taut:?}");
+        let (lt, lg) = (path_length(&taut), path_length(&grid));
+        assert!(lt < lg, "{lt} {lg}");
+        // Every bend is below the wall's end, by about the object's clearance.
+        let keep = ws.object_radius + p.object_margin;
+        for v in &taut[1..taut.len() - 1] {
+            assert!(v.y < 0.45 && clearance(*v, &wall) >= keep - 1e-9, "{v:?}");
+            assert!(clearance(*v, &wall) < keep + 0.03, "{v:?}");
+        }
+        // No path is shorter than the legs through the wall's lower corners inflated by `keep`.
+        let corner = Vector2::new(0.83, 0.45 - keep);
+        assert!(
+            lt >= (corner - s).norm() + (g - corner).norm() - 0.02,
+            "{lt}"
+        );
     }
 }

@@ -57,7 +57,7 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
 }
 
 /// Trajectories of robot (blue) and object marker (red) on the scene's table, one group per
-/// labelled run, with the goal and the start positions.
+/// labelled run, with the obstacles, the goal and the start positions.
 pub fn trajectories_svg(
     runs: &[(String, Vec<(Pose2, Pose2)>)],
     scene: &Scene,
@@ -66,6 +66,9 @@ pub fn trajectories_svg(
     let f = Frame::table(scene.table.width, scene.table.height, 500.0);
     let mut d = Doc::for_frame(&f);
     d.background(&Style::new().fill("white").stroke("black"));
+    for o in &scene.obstacles {
+        d.polygon(&f.map_all(&o.outline), &Style::new().fill("#777"));
+    }
     d.circle(
         f.map([goal.x, goal.y]),
         f.length(0.022),
