@@ -7,8 +7,10 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand, ValueEnum};
 
 use super::CliError;
+use crate::exec::collect::{CollectParams, DEFAULT_INITIAL};
 use crate::exec::deliver::DeliveryParams;
-use crate::strategy::regression::KernelParams;
+use crate::strategy::active::Selection;
+use crate::strategy::regression::{Admission, KernelParams};
 
 /// Settings shared by collection and evaluation.
 #[derive(Args, Debug, Clone)]
@@ -49,6 +51,66 @@ impl SimArgs {
     }
 }
 
+/// How the initial collection chooses its pushes.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SelectionArg {
+    /// A random spin and push length (the paper).
+    Random,
+    /// Of several random pushes, the one the strategy knows least.
+    Uncertain,
+}
+
+/// Which pushes of the collection's evaluation become samples.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KeepArg {
+    /// Every push (the paper).
+    All,
+    /// Only pushes into a region the strategy has not seen, or whose outcome it mispredicted.
+    Informative,
+}
+
+/// How the collection chooses and keeps its pushes (issue 24: fewer samples to learn).
+#[derive(Args, Debug, Clone)]
+pub struct ActiveArgs {
+    /// How the initial collection chooses its pushes.
+    #[arg(long, value_enum, default_value_t = SelectionArg::Uncertain)]
+    pub selection: SelectionArg,
+    /// Which pushes of the collection's evaluation are kept as samples.
+    #[arg(long, value_enum, default_value_t = KeepArg::Informative)]
+    pub keep: KeepArg,
+    /// With `--keep informative`: a push whose (p, s) lies farther than this from every sample
+    /// is new, m [default: 0.01]
+    #[arg(long)]
+    pub novel_distance: Option<f64>,
+    /// With `--keep informative`: a push whose robot motion differs by more than this from the
+    /// strategy's answer at its (p, s) is a surprise, degrees [default: 20]
+    #[arg(long)]
+    pub surprise_deg: Option<f64>,
+}
+
+impl ActiveArgs {
+    /// `params` with this selection and admission.
+    pub fn apply(&self, params: CollectParams) -> CollectParams {
+        CollectParams {
+            selection: match self.selection {
+                SelectionArg::Random => Selection::Random,
+                SelectionArg::Uncertain => Selection::Uncertain,
+            },
+            admission: match self.keep {
+                KeepArg::All => None,
+                KeepArg::Informative => {
+                    let d = Admission::default();
+                    Some(Admission {
+                        novel_distance: self.novel_distance.unwrap_or(d.novel_distance),
+                        surprise: self.surprise_deg.map_or(d.surprise, f64::to_radians),
+                    })
+                }
+            },
+            ..params
+        }
+    }
+}
+
 /// `pushbot collect`: collect a pushing strategy (Algorithm 1) in the simulation.
 #[derive(Args, Debug)]
 pub struct CollectArgs {
@@ -62,8 +124,9 @@ pub struct CollectArgs {
     /// Strategy file to append to (default: `<object>.strategy`); an existing file is resumed.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// K: samples of the initial collection.
-    #[arg(long, default_value_t = 300)]
+    /// K: samples of the initial collection (the paper's collection: 300 with `--selection
+    /// random --keep all`).
+    #[arg(long, default_value_t = DEFAULT_INITIAL)]
     pub initial: usize,
     /// Stop the evaluation after this many straight successful queries.
     #[arg(long, default_value_t = 10)]
@@ -74,6 +137,8 @@ pub struct CollectArgs {
     /// Write the strategy as an SVG (Fig. 7 style).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub active: ActiveArgs,
     #[command(flatten)]
     pub sim: SimArgs,
 }
@@ -140,7 +205,7 @@ pub struct DeliveryArgs {
     #[arg(long)]
     pub strategy_dir: Option<PathBuf>,
     /// K of the collection when no strategy file is given.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = DEFAULT_INITIAL)]
     pub initial: usize,
     /// Time limit of one trial, s of simulated time (the paper: 8 minutes).
     #[arg(long, default_value_t = 480.0)]
@@ -167,9 +232,21 @@ pub struct DeliveryArgs {
     /// collection only).
     #[arg(long, default_value_t = 10)]
     pub streak: usize,
-    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG.
+    /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG; with
+    /// `--figure`, the figure.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Draw one of Lau et al.'s figures instead of the trials: 7, the data-need curve (success
+    /// of `--trials` deliveries per start after every `--every` samples, while collecting the
+    /// paper's way and the active way; table printed, SVG to `--svg` [default:
+    /// data-need.svg]).
+    #[arg(long)]
+    pub figure: Option<u8>,
+    /// With `--figure 7`: samples between the curve's points.
+    #[arg(long, default_value_t = 25)]
+    pub every: usize,
+    #[command(flatten)]
+    pub active: ActiveArgs,
     #[command(flatten)]
     pub sim: SimArgs,
 }

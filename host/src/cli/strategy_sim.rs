@@ -104,13 +104,13 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
     let (mut writer, existing) =
         StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
     let had = existing.len();
-    let params = CollectParams {
+    let params = a.active.apply(CollectParams {
         initial: a.initial,
         streak: a.streak,
         max_queries: a.max_queries,
         seed: global.seed,
         ..CollectParams::default()
-    };
+    });
     let outline = object_outline(&scene, id.as_deref());
     let (strategy, rep) = collect_in_sim(
         global,
@@ -161,6 +161,15 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
 
 /// `pushbot eval delivery` on simulated trials.
 pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
+    match a.figure {
+        None => {}
+        Some(7) => return super::data_need::run_figure7(global, &a),
+        Some(n) => {
+            return Err(CliError::bad_input(format!(
+                "--figure {n}: the figures drawn are 7 (the data-need curve)"
+            )));
+        }
+    }
     let starts = parse_starts(&a.start).map_err(CliError::bad_input)?;
     let names: Vec<String> = if a.scene.trim() == "lau-all" {
         LAU_SCENES.iter().map(|s| (*s).to_owned()).collect()
@@ -210,12 +219,12 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
         setup.goal().map_err(CliError::BadInput)?;
         // The strategy: from a file, from the cache directory (collected there when missing),
         // or collected here first.
-        let params = CollectParams {
+        let params = a.active.apply(CollectParams {
             initial: a.initial,
             streak: a.streak,
             seed: global.seed,
             ..CollectParams::default()
-        };
+        });
         let mut collection = None;
         let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
             Vec::new()

@@ -425,8 +425,9 @@ pub fn deliver_learned_among(
         let (r1, o1) = (io.robot_pose(), io.object_pose());
         let sample = Sample::from_push(r0, r1, o0, o1);
         let moved = o1.position() - o0.position();
-        if moved.norm() >= p.moved_epsilon {
-            strategy.add(sample);
+        // Supplemental sample, used at once (kept only if informative when the strategy has an
+        // admission rule: a collection's selective sampling).
+        if moved.norm() >= p.moved_epsilon && strategy.offer(sample) {
             sink(&sample)?;
         }
         // Special case next when the push moved the object away from the goal, or did not move
