@@ -126,7 +126,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
                 streak: a.streak,
                 seed: global.seed,
                 ..CollectParams::default()
-            });
+            })?;
             // With --strategy-dir every sample is written as it is collected: a collection cut
             // short (a link that did not come back, a person stopping it) keeps what it had, and
             // the next run goes on from there.

@@ -89,9 +89,16 @@ pub struct ActiveArgs {
 }
 
 impl ActiveArgs {
-    /// `params` with this selection and admission.
-    pub fn apply(&self, params: CollectParams) -> CollectParams {
-        CollectParams {
+    /// `params` with this selection and admission; an error for a negative or non-finite
+    /// threshold.
+    pub fn apply(&self, params: CollectParams) -> Result<CollectParams, CliError> {
+        let ok = |v: Option<f64>| v.is_none_or(|v| v.is_finite() && v >= 0.0);
+        if !ok(self.novel_distance) || !ok(self.surprise_deg) {
+            return Err(CliError::bad_input(
+                "--novel-distance and --surprise-deg must be finite and not negative",
+            ));
+        }
+        Ok(CollectParams {
             selection: match self.selection {
                 SelectionArg::Random => Selection::Random,
                 SelectionArg::Uncertain => Selection::Uncertain,
@@ -107,7 +114,7 @@ impl ActiveArgs {
                 }
             },
             ..params
-        }
+        })
     }
 }
 

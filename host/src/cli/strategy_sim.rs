@@ -110,7 +110,7 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
         max_queries: a.max_queries,
         seed: global.seed,
         ..CollectParams::default()
-    });
+    })?;
     let outline = object_outline(&scene, id.as_deref());
     let (strategy, rep) = collect_in_sim(
         global,
@@ -224,7 +224,7 @@ pub(super) fn eval_in_sim(global: &Global, a: DeliveryArgs) -> CliResult {
             streak: a.streak,
             seed: global.seed,
             ..CollectParams::default()
-        });
+        })?;
         let mut collection = None;
         let samples: Vec<Sample> = if !methods.contains(&Method::Learned) {
             Vec::new()

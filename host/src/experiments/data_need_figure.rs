@@ -102,6 +102,7 @@ pub fn data_need_svg(curves: &[Curve]) -> String {
                 );
             }
         }
+        d.group(g);
     }
     // Legend.
     let mut x = 10.0;
