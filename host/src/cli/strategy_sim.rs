@@ -101,9 +101,6 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.strategy", a.object)));
-    let (mut writer, existing) =
-        StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
-    let had = existing.len();
     let params = a.active.apply(CollectParams {
         initial: a.initial,
         streak: a.streak,
@@ -111,6 +108,9 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
         seed: global.seed,
         ..CollectParams::default()
     })?;
+    let (mut writer, existing) =
+        StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
+    let had = existing.len();
     let outline = object_outline(&scene, id.as_deref());
     let (strategy, rep) = collect_in_sim(
         global,
