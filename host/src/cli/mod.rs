@@ -10,6 +10,8 @@ use std::process::ExitCode;
 
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
+#[cfg(feature = "sim")]
+mod data_need;
 pub mod demo;
 pub mod lens;
 pub mod link_bench;

@@ -30,6 +30,11 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
     if !(a.time_limit.is_finite() && a.time_limit > 0.0) {
         return Err(CliError::bad_input("--time-limit must be positive"));
     }
+    if a.hil && a.figure.is_some() {
+        return Err(CliError::bad_input(
+            "--figure runs in the simulation; leave out --hil",
+        ));
+    }
     if a.hil {
         let name = a
             .scene
@@ -119,12 +124,12 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
                 .samples
         }
         (Method::Learned, None) => {
-            let params = CollectParams {
+            let params = a.active.apply(CollectParams {
                 initial: a.initial,
                 streak: a.streak,
                 seed: global.seed,
                 ..CollectParams::default()
-            };
+            })?;
             // With --strategy-dir every sample is written as it is collected: a collection cut
             // short (a link that did not come back, a person stopping it) keeps what it had, and
             // the next run goes on from there.

@@ -7,8 +7,10 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand, ValueEnum};
 
 use super::CliError;
+use crate::exec::collect::{CollectParams, DEFAULT_INITIAL};
 use crate::exec::deliver::DeliveryParams;
-use crate::strategy::regression::KernelParams;
+use crate::strategy::active::Selection;
+use crate::strategy::regression::{Admission, KernelParams};
 
 /// Settings shared by collection and evaluation.
 #[derive(Args, Debug, Clone)]
@@ -64,6 +66,73 @@ impl SimArgs {
     }
 }
 
+/// How the initial collection chooses its pushes.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SelectionArg {
+    /// A random spin and push length (the paper).
+    Random,
+    /// Of several random pushes, the one the strategy knows least.
+    Uncertain,
+}
+
+/// Which pushes of the collection's evaluation become samples.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KeepArg {
+    /// Every push (the paper).
+    All,
+    /// Only pushes into a region the strategy has not seen, or whose outcome it mispredicted.
+    Informative,
+}
+
+/// How the collection chooses and keeps its pushes (issue 24: fewer samples to learn).
+#[derive(Args, Debug, Clone)]
+pub struct ActiveArgs {
+    /// How the initial collection chooses its pushes.
+    #[arg(long, value_enum, default_value_t = SelectionArg::Uncertain)]
+    pub selection: SelectionArg,
+    /// Which pushes of the collection's evaluation are kept as samples.
+    #[arg(long, value_enum, default_value_t = KeepArg::Informative)]
+    pub keep: KeepArg,
+    /// With `--keep informative`: a push whose (p, s) lies farther than this from every sample
+    /// is new, m [default: 0.01]
+    #[arg(long)]
+    pub novel_distance: Option<f64>,
+    /// With `--keep informative`: a push whose robot motion differs by more than this from the
+    /// strategy's answer at its (p, s) is a surprise, degrees [default: 20]
+    #[arg(long)]
+    pub surprise_deg: Option<f64>,
+}
+
+impl ActiveArgs {
+    /// `params` with this selection and admission; an error for a negative or non-finite
+    /// threshold.
+    pub fn apply(&self, params: CollectParams) -> Result<CollectParams, CliError> {
+        let ok = |v: Option<f64>| v.is_none_or(|v| v.is_finite() && v >= 0.0);
+        if !ok(self.novel_distance) || !ok(self.surprise_deg) {
+            return Err(CliError::bad_input(
+                "--novel-distance and --surprise-deg must be finite and not negative",
+            ));
+        }
+        Ok(CollectParams {
+            selection: match self.selection {
+                SelectionArg::Random => Selection::Random,
+                SelectionArg::Uncertain => Selection::Uncertain,
+            },
+            admission: match self.keep {
+                KeepArg::All => None,
+                KeepArg::Informative => {
+                    let d = Admission::default();
+                    Some(Admission {
+                        novel_distance: self.novel_distance.unwrap_or(d.novel_distance),
+                        surprise: self.surprise_deg.map_or(d.surprise, f64::to_radians),
+                    })
+                }
+            },
+            ..params
+        })
+    }
+}
+
 /// `pushbot collect`: collect a pushing strategy (Algorithm 1) in the simulation.
 #[derive(Args, Debug)]
 pub struct CollectArgs {
@@ -77,8 +146,9 @@ pub struct CollectArgs {
     /// Strategy file to append to (default: `<object>.strategy`); an existing file is resumed.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// K: samples of the initial collection.
-    #[arg(long, default_value_t = 300)]
+    /// K: samples of the initial collection (the paper's collection: 300 with `--selection
+    /// random --keep all`).
+    #[arg(long, default_value_t = DEFAULT_INITIAL)]
     pub initial: usize,
     /// Stop the evaluation after this many straight successful queries.
     #[arg(long, default_value_t = 10)]
@@ -89,6 +159,8 @@ pub struct CollectArgs {
     /// Write the strategy as an SVG (Fig. 7 style).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub active: ActiveArgs,
     #[command(flatten)]
     pub sim: SimArgs,
 }
@@ -134,10 +206,13 @@ pub struct DeliveryArgs {
     /// path (learned method).
     #[arg(long, required_unless_present = "figure")]
     pub scene: Option<String>,
-    /// Run one of Lau et al.'s evaluations whole and draw it: `11` is Fig. 11 — the six
+    /// Run one of Lau et al.'s evaluations whole and draw it. `11` is Fig. 11 — the six
     /// objects × starts A–F, learned and dipole side by side, `--trials` each, on all cores,
     /// with the rendered camera in the loop (unless `--sim-camera truth`); it prints the table
-    /// and writes the figure to `--svg` (default `fig11.svg`).
+    /// and writes the figure to `--svg` (default `fig11.svg`). `7` is the data-need curve
+    /// (success of `--trials` deliveries per start after every `--every` samples, while
+    /// collecting the paper's way and the active way; table printed, SVG to `--svg` [default:
+    /// data-need.svg]).
     #[arg(long, value_name = "N")]
     pub figure: Option<u8>,
     /// Object id in the scene (default: the first).
@@ -161,7 +236,7 @@ pub struct DeliveryArgs {
     #[arg(long)]
     pub strategy_dir: Option<PathBuf>,
     /// K of the collection when no strategy file is given.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = DEFAULT_INITIAL)]
     pub initial: usize,
     /// Time limit of one trial, s of simulated time (the paper: 8 minutes).
     #[arg(long, default_value_t = 480.0)]
@@ -192,6 +267,11 @@ pub struct DeliveryArgs {
     /// of it beside; with `--figure`, the figure.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// With `--figure 7`: samples between the curve's points.
+    #[arg(long, default_value_t = 25)]
+    pub every: usize,
+    #[command(flatten)]
+    pub active: ActiveArgs,
     #[command(flatten)]
     pub sim: SimArgs,
 }

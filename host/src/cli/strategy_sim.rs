@@ -112,16 +112,16 @@ pub(super) fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.strategy", a.object)));
-    let (mut writer, existing) =
-        StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
-    let had = existing.len();
-    let params = CollectParams {
+    let params = a.active.apply(CollectParams {
         initial: a.initial,
         streak: a.streak,
         max_queries: a.max_queries,
         seed: global.seed,
         ..CollectParams::default()
-    };
+    })?;
+    let (mut writer, existing) =
+        StrategyWriter::open(&out, &a.object).map_err(|e| CliError::bad_input(e.to_string()))?;
+    let had = existing.len();
     let outline = object_outline(&scene, id.as_deref());
     let (strategy, rep) = collect_in_sim(
         global,
@@ -184,12 +184,12 @@ fn strategy_for(
     setup: &TrialSetup,
     quiet: bool,
 ) -> Result<(Vec<Sample>, Option<CollectReport>), CliError> {
-    let params = CollectParams {
+    let params = a.active.apply(CollectParams {
         initial: a.initial,
         streak: a.streak,
         seed: global.seed,
         ..CollectParams::default()
-    };
+    })?;
     if let Some(path) = &a.strategy {
         let samples = store::load(path)
             .map_err(|e| CliError::bad_input(e.to_string()))?
@@ -249,9 +249,11 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
                 "--figure 11 runs Lau et al.'s six objects; it takes no --scene ({s})"
             )));
         }
+        (Some(7), _) => return super::data_need::run_figure7(global, &a),
         (Some(n), _) => {
             return Err(CliError::bad_input(format!(
-                "--figure {n}: this command draws Lau et al.'s Fig. 11 (--figure 11)"
+                "--figure {n}: the figures drawn are 7 (the data-need curve) and 11 (success per \
+                 start, Lau et al. Fig. 11)"
             )));
         }
     }

@@ -9,8 +9,10 @@
 //! from the goal (or did not move it: the robot lost contact) — for both the position p to push
 //! from and the direction r, and move there around the object's bound-all circle (Fig. 3, 4b).
 //! Motion is two-level (§IV): spins are corrected once at a finer level, and pushes are long
-//! (coarse) far from the goal and short (fine) near it. Every push is a supplemental sample
-//! (§III-D), handed to a sink and usable at once.
+//! (coarse) far from the goal and short (fine) near it. Every push that moved the object is a
+//! supplemental sample (§III-D), handed to a sink and usable at once — unless the strategy has an
+//! admission rule (a collection's evaluation keeps only informative pushes,
+//! [`crate::strategy::regression::Admission`]).
 
 use anyhow::Result;
 use nalgebra::Vector2;
@@ -430,8 +432,9 @@ pub fn deliver_learned_among(
         let (r1, o1) = (io.robot_pose(), io.object_pose());
         let sample = Sample::from_push(r0, r1, o0, o1);
         let moved = o1.position() - o0.position();
-        if moved.norm() >= p.moved_epsilon {
-            strategy.add(sample);
+        // Supplemental sample, used at once (kept only if informative when the strategy has an
+        // admission rule: a collection's selective sampling).
+        if moved.norm() >= p.moved_epsilon && strategy.offer(sample) {
             sink(&sample)?;
         }
         // Special case next when the push moved the object away from the goal, or did not move

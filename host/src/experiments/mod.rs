@@ -6,6 +6,8 @@
 //! - `strategy_eval`: delivery trials of the learned strategy and the dipole field from the
 //!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
 //! - `fig11`: Lau et al. Fig. 11's table and figure from those trials.
+//! - `data_need`, `data_need_figure`: samples collected vs delivery success, for the paper's
+//!   collection and the active one (issue 24, `eval delivery --figure 7`).
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
 //! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
@@ -15,6 +17,10 @@
 //! - `link_bench`: commands through a faulty wire to the in-process target (`pushbot bench
 //!   link`).
 
+#[cfg(feature = "sim")]
+pub mod data_need;
+#[cfg(feature = "sim")]
+pub mod data_need_figure;
 #[cfg(feature = "sim")]
 pub mod delivery;
 #[cfg(feature = "sim")]

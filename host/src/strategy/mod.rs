@@ -7,11 +7,13 @@
 //! - [`store`]: the pushing strategy on disk, versioned, appended and flushed sample by sample.
 //! - [`regression`]: k-nearest-neighbour kernel regression of Algorithm 2 (§III-E), general
 //!   and special case, on k-d trees.
+//! - [`active`]: choosing the next push where the strategy is least sure (active selection).
 //! - [`dipole`]: the dipole field used as the baseline in §V (Fig. 10–11).
 //!
 //! The loops that act — collection (Algorithm 1) and delivery (Algorithm 2) — are executors in
 //! [`crate::exec`]; the global path among obstacles is [`crate::planner::global`].
 
+pub mod active;
 pub mod bench;
 pub mod dipole;
 pub mod figures;

@@ -44,6 +44,29 @@ pub struct Reposition {
     pub r: [f64; 2],
 }
 
+/// Which pushes [`PushStrategy::offer`] keeps: only those that teach the strategy something
+/// (selective sampling). A push is informative when its (p, s) lies farther than
+/// `novel_distance` from every sample (a region the strategy has not seen), or when the robot
+/// motion the strategy answers at its (p, s) points more than `surprise` away from the robot
+/// motion that really produced s (the strategy is wrong there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Admission {
+    /// Distance in (p_x, p_y, s_x, s_y) beyond which a push is new, m.
+    pub novel_distance: f64,
+    /// Angle between the answered and the real robot motion beyond which a push is a surprise,
+    /// rad.
+    pub surprise: f64,
+}
+
+impl Default for Admission {
+    fn default() -> Self {
+        Admission {
+            novel_distance: 0.01,
+            surprise: 20f64.to_radians(),
+        }
+    }
+}
+
 /// Samples added since the trees were built are searched linearly up to this many.
 const REBUILD_AFTER: usize = 256;
 
@@ -57,6 +80,7 @@ pub struct PushStrategy {
     special: Option<ImmutableKdTree<f64, 2>>,
     indexed: usize,
     s_len_sum: f64,
+    admission: Option<Admission>,
 }
 
 fn general_key(s: &Sample) -> [f64; 4] {
@@ -82,6 +106,7 @@ impl PushStrategy {
             general: None,
             special: None,
             indexed: 0,
+            admission: None,
         };
         s.rebuild();
         s
@@ -112,6 +137,43 @@ impl PushStrategy {
         }
     }
 
+    /// Set which pushes [`Self::offer`] keeps: `None` keeps every push (the paper).
+    pub fn set_admission(&mut self, admission: Option<Admission>) {
+        self.admission = admission;
+    }
+
+    /// Offer a push observed while the strategy is in use (a supplemental sample): added, and
+    /// `true` returned, when the admission rule (if any) finds it informative
+    /// ([`Self::informative`]).
+    pub fn offer(&mut self, s: Sample) -> bool {
+        if !s.is_finite() {
+            return false;
+        }
+        if self.admission.is_some_and(|a| !self.informative(&s, &a)) {
+            return false;
+        }
+        self.add(s);
+        true
+    }
+
+    /// Whether `s` would teach the strategy something under `a` (see [`Admission`]).
+    pub fn informative(&self, s: &Sample, a: &Admission) -> bool {
+        let key = general_key(s);
+        let near = self.nearest(self.general.as_ref(), general_key, &key);
+        let Some(&(d2, _)) = near.first() else {
+            return true;
+        };
+        if d2.sqrt() > a.novel_distance {
+            return true;
+        }
+        let Some(r) = self.predict(s.p, s.s) else {
+            return true;
+        };
+        let turn = (r[1].atan2(r[0]) - s.r[1].atan2(s.r[0])).abs();
+        let turn = turn.min(2.0 * std::f64::consts::PI - turn);
+        turn > a.surprise
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.samples.len()
@@ -120,6 +182,11 @@ impl PushStrategy {
     /// Whether there are no samples.
     pub fn is_empty(&self) -> bool {
         self.samples.is_empty()
+    }
+
+    /// The kernel parameters.
+    pub fn params(&self) -> KernelParams {
+        self.params
     }
 
     /// The samples.
@@ -176,7 +243,13 @@ impl PushStrategy {
     /// non-finite query.
     pub fn general(&self, p: [f64; 2], goal_dir: [f64; 2]) -> Option<[f64; 2]> {
         let off = self.offset();
-        let q = [p[0], p[1], off * goal_dir[0], off * goal_dir[1]];
+        self.predict(p, [off * goal_dir[0], off * goal_dir[1]])
+    }
+
+    /// The general case at a raw key: the kernel-weighted robot motion of the k samples nearest
+    /// to (p, s), object frame. `None` without samples or for a non-finite query.
+    pub fn predict(&self, p: [f64; 2], s: [f64; 2]) -> Option<[f64; 2]> {
+        let q = [p[0], p[1], s[0], s[1]];
         if q.iter().any(|v| !v.is_finite()) {
             return None;
         }
@@ -324,6 +397,36 @@ mod tests {
         let empty = PushStrategy::new(Vec::new(), KernelParams::default());
         assert!(empty.general([0.0, 0.0], [1.0, 0.0]).is_none());
         assert!(empty.special([1.0, 0.0]).is_none());
+    }
+
+    #[test]
+    fn an_admission_rule_keeps_only_new_or_mispredicted_pushes() {
+        let samples = random_samples(500, 11);
+        let mut strat = PushStrategy::new(samples.iter().copied(), KernelParams::default());
+        // Without a rule every push is kept (the paper).
+        assert!(strat.offer(samples[0]));
+        strat.set_admission(Some(Admission::default()));
+        // A push the strategy has seen exactly: neither new nor a surprise.
+        let seen = samples[1];
+        assert!(!strat.offer(seen));
+        // The same (p, s) reached by a robot motion turned 90°: a surprise.
+        let turned = Sample {
+            r: [-seen.r[1], seen.r[0]],
+            ..seen
+        };
+        assert!(strat.informative(&turned, &Admission::default()));
+        // A push from where the robot never stood: new.
+        let far = Sample {
+            p: [0.3, 0.3],
+            ..seen
+        };
+        let n = strat.len();
+        assert!(strat.offer(far));
+        assert_eq!(strat.len(), n + 1);
+        assert!(!strat.offer(Sample {
+            theta: f64::NAN,
+            ..far
+        }));
     }
 
     #[test]

@@ -1,0 +1,66 @@
+//! Issue 24, fewer samples to learn: the active collection (uncertain initial pushes, a short
+//! initial collection, only informative supplemental samples) reaches Lau et al.'s 10-streak
+//! (§III-D) within 300 samples, and the data-need curve (`eval delivery --figure 7`) has its
+//! shape.
+
+use pushbot::exec::collect::CollectParams;
+use pushbot::exec::deliver::DeliveryParams;
+use pushbot::experiments::data_need::{
+    DataNeedSetup, VARIANTS, checkpoints, collect_clear, data_need, variant_params,
+};
+use pushbot::sim::robot::SimRobotOptions;
+use pushbot::strategy::active::Selection;
+use pushbot::strategy::regression::KernelParams;
+use pushbot_sim::Scene;
+
+fn setup() -> DataNeedSetup {
+    DataNeedSetup {
+        every: 50,
+        tests: 2,
+        max_samples: 1000,
+        streak: 10,
+        seed: 1,
+        sim: SimRobotOptions::default(),
+        delivery: DeliveryParams::default(),
+        kernel: KernelParams::default(),
+        starts: vec!["E".into(), "F".into()],
+    }
+}
+
+#[test]
+fn the_default_collection_is_the_active_one() {
+    let p = CollectParams::default();
+    assert_eq!(p.selection, Selection::Uncertain);
+    assert!(p.admission.is_some());
+    assert!(p.initial < 300);
+    let uncertain = VARIANTS.iter().find(|v| v.name == "uncertain").unwrap();
+    assert_eq!(variant_params(uncertain, &setup()).initial, p.initial);
+}
+
+#[test]
+fn the_data_need_curve_of_the_active_collection_reaches_the_streak_within_300_samples() {
+    let scene = Scene::preset("lau-irregular").unwrap();
+    let s = setup();
+    let uncertain = *VARIANTS.iter().find(|v| v.name == "uncertain").unwrap();
+    let curves = data_need(std::slice::from_ref(&scene), &[uncertain], &s).unwrap();
+    let [c] = curves.as_slice() else {
+        panic!("one scene × one variant: {} curves", curves.len())
+    };
+    let rep = &c.collection;
+    let n = c.streak_at.expect("10 straight successes");
+    assert!(n <= 300, "{n} samples: {rep:?}");
+    assert_eq!(n, rep.initial_samples + rep.supplemental_samples);
+    // Informative pushes only: the evaluation pushed more than it kept.
+    assert!(rep.evaluation_pushes > rep.supplemental_samples, "{rep:?}");
+    // A point every 50 samples and one at the end, each with its test deliveries.
+    let at: Vec<usize> = c.points.iter().map(|p| p.samples).collect();
+    assert_eq!(at, checkpoints(n, 50, 1000));
+    assert!(c.points.iter().all(|p| p.tests == 2 && p.successes <= 2));
+    // The strategy that reached the streak delivers from the scene's starts.
+    assert!(c.points.last().unwrap().successes >= 1, "{:?}", c.points);
+
+    // Reproducible from the seed: the same collection again.
+    let (samples, again) = collect_clear(&scene, &variant_params(&uncertain, &s), &s).unwrap();
+    assert_eq!(samples.len(), n);
+    assert_eq!(again.evaluation_pushes, rep.evaluation_pushes);
+}
