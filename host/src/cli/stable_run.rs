@@ -50,6 +50,10 @@ pub struct StableRunArgs {
     /// With --hil: simulated seconds per wall second.
     #[arg(long = "sim-speed", default_value_t = 8.0)]
     pub speed: f64,
+    /// Write each trial's drawing (the plan, and the slider's executed path over it) into this
+    /// folder as `trial-N.svg`.
+    #[arg(long)]
+    pub svg: Option<std::path::PathBuf>,
 }
 
 /// `pushbot eval stable`.
@@ -146,6 +150,9 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     for (t, res) in trials.iter().zip(results) {
         rows.push(res.map_err(|e| CliError::Failed(e.context(format!("trial {t}"))))?);
     }
+    if let Some(dir) = &r.svg {
+        write_svgs(dir, &task, &rows)?;
+    }
     let reached = rows.iter().filter(|t| t.reached).count();
     let n = rows.len();
     let mean = |f: &dyn Fn(&StableTrial) -> f64| rows.iter().map(f).sum::<f64>() / n as f64;
@@ -203,6 +210,24 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     } else {
         Status::TaskFailed
     })
+}
+
+/// Each trial's plan with its executed path, as `dir/trial-N.svg`.
+#[cfg(feature = "sim")]
+fn write_svgs(
+    dir: &std::path::Path,
+    task: &crate::experiments::stable_trials::StableTask,
+    rows: &[crate::experiments::stable_trials::StableTrial],
+) -> Result<(), CliError> {
+    use crate::planner::stable::svg::render_executed;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::bad_input(format!("--svg {}: {e}", dir.display())))?;
+    for t in rows {
+        let f = dir.join(format!("trial-{}.svg", t.trial));
+        std::fs::write(&f, render_executed(&task.problem, Some(&task.plan), &t.path))
+            .map_err(|e| CliError::bad_input(format!("{}: {e}", f.display())))?;
+    }
+    Ok(())
 }
 
 #[cfg(not(feature = "sim"))]

@@ -11,7 +11,7 @@ use pushbot_world::scene::perturb::Perturb;
 
 use crate::exec::io::RobotIo;
 use crate::exec::stable::execute;
-use crate::exec::stable_feedback::{FeedbackParams, execute_closed_loop, plan_inner};
+use crate::exec::stable_feedback::{FeedbackParams, execute_closed_loop, plan_clear};
 use crate::planner::stable::presets::{PRESETS, Scene as StableScene, load_scene};
 use crate::planner::stable::robot::{
     SPEED, robot_problem, robot_problem_in, robot_problem_scene, robot_start, sim_scene,
@@ -67,7 +67,7 @@ pub struct StableTask {
     /// Its problem.
     pub problem: Problem,
     /// The plan (found), made with the nominal model for the inner part of the goal
-    /// neighbourhood ([`plan_inner`]).
+    /// neighbourhood, clear of the obstacles where it can be ([`plan_clear`]).
     pub plan: Plan,
     /// The perturbation ranges: the scene's `[perturb]` or the defaults.
     pub ranges: Perturb,
@@ -99,7 +99,7 @@ impl StableTask {
             // and the robot's plate.
             robot_problem_scene(name)?
         };
-        let Some(pl) = plan_inner(&problem).filter(|pl| !pl.steps.is_empty()) else {
+        let Some(pl) = plan_clear(&problem).filter(|pl| !pl.steps.is_empty()) else {
             bail!(
                 "scene {name}: no plan of stable pushes for the plated robot ({} configurations \
                  expanded)",
