@@ -24,12 +24,13 @@ use anyhow::{Context, Result, bail};
 
 use crate::exec::io::RobotIo;
 use crate::exec::stable::{approach, drive_transit, flush_pose, observe};
+use crate::exec::stable_replan::{plan_clear, plan_from};
+use crate::exec::stable_start::{go_to_first_contact, on_edge, start_path};
 use crate::mechanics::{V2, V3, cross};
-use crate::planner::stable::collision::{Body, Obstacle};
-use crate::planner::stable::exact::finish_exactly;
+use crate::planner::stable::pusher::PusherKind;
 use crate::planner::stable::robot::{SPEED, robot_in_slider};
 use crate::planner::stable::transit::transit;
-use crate::planner::stable::{Plan, Pose, Problem, angle_diff, plan as plan_stable};
+use crate::planner::stable::{Plan, Pose, Problem, angle_diff};
 
 /// Settings of the closed loop.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -216,6 +217,14 @@ fn track(
     let ci = seg.contact;
     let (k_right, k_left) = stable_curvatures(p, ci);
     let (k_min, k_max) = (k_right * fp.stable_margin, k_left * fp.stable_margin);
+    // A car turns no tighter than its radius (Fig. 14): its plan's pushes do not, nor may the
+    // corrections.
+    let k_car = match p.pusher.kind {
+        PusherKind::Car { min_turning_radius } if min_turning_radius > 0.0 => {
+            1.0 / min_turning_radius
+        }
+        _ => f64::INFINITY,
+    };
     let n = seg.pts.len();
     let total = seg.cum[n - 1];
     // Start from the nearest point of the whole path (it may be taken up half-way).
@@ -289,7 +298,8 @@ fn track(
         // pushes, on the set's boundary); the corrections stay inside the set.
         let k_ref = seg.kappa[idx];
         let kappa = (k_ref - fp.k_lateral * e - fp.k_heading * th_e.sin())
-            .clamp(k_min.min(k_ref), k_max.max(k_ref));
+            .clamp(k_min.min(k_ref), k_max.max(k_ref))
+            .clamp(-k_car, k_car);
         let ds = fp.control_step.min(remaining.max(0.002));
         let dur = ds / SPEED;
         io.drive(SPEED, kappa * SPEED, dur)
@@ -317,150 +327,9 @@ fn replan(p: &Problem, s: Pose, ci: usize, run: &mut FeedbackRun) -> Option<Plan
     found
 }
 
-/// A plan from the measured slider pose `s`, the plate on contact `ci`: on that contact first
-/// (no contact change, [`plan_inner`]); else starting on any pushing edge (the executor
-/// transits to it). The planner refuses a start where the slider (with the pusher) touches an
-/// obstacle, and a slider the closed loop let graze a wall is such a start: then the same from
-/// the nearest free pose within [`NUDGE`] (the closed loop takes up the difference).
-pub fn plan_from(p: &Problem, s: Pose, ci: usize) -> Option<Plan> {
-    let kept = with_margin(p, MARGIN);
-    let attempt = |q0: Pose| {
-        [&kept, p].into_iter().find_map(|base| {
-            [Some(ci), None].into_iter().find_map(|sc| {
-                let mut q = base.clone();
-                q.start = q0;
-                q.start_contact = sc;
-                plan_inner(&q).filter(|pl| match pl.steps.first() {
-                    // A plan on another edge needs a way there from the plate's.
-                    Some(st) => st.contact == ci || transit(p, &q0, ci, st.contact, 0).is_some(),
-                    None => p.in_goal(&q0),
-                })
-            })
-        })
-    };
-    if let Some(pl) = attempt(s) {
-        return Some(pl);
-    }
-    let free = |q: &Pose| {
-        p.contacts
-            .iter()
-            .any(|c| c.body.clearance(&p.world, q, NUDGE) > NUDGE_CLEARANCE)
-    };
-    if free(&s) {
-        return None;
-    }
-    // Nearest first: rings of 2 mm, 16 directions, the heading as measured or ±2°.
-    for k in 1..=(NUDGE / 0.002).round() as usize {
-        let r = 0.002 * k as f64;
-        for j in 0..16 {
-            let a = j as f64 * std::f64::consts::TAU / 16.0;
-            for dth in [0.0, 2f64.to_radians(), -(2f64.to_radians())] {
-                let q = Pose::new(s.x + r * a.cos(), s.y + r * a.sin(), s.theta + dth);
-                if free(&q) {
-                    tracing::info!(
-                        "stable closed loop: the slider touches an obstacle; planning from \
-                         {:.1} mm, {:.0}° away",
-                        r * 1e3,
-                        dth.to_degrees()
-                    );
-                    return attempt(q);
-                }
-            }
-        }
-    }
-    None
-}
-
-/// A plan for `p` ([`plan_inner`]) that keeps [`MARGIN`] from the obstacles where one does,
-/// else one that may graze them.
-pub fn plan_clear(p: &Problem) -> Option<Plan> {
-    plan_inner(&with_margin(p, MARGIN))
-        .filter(|pl| !pl.steps.is_empty())
-        .or_else(|| plan_inner(p))
-}
-
-/// The clearance plans keep from obstacles where they can ([`with_margin`]), m: a plan that
-/// grazes a wall is one the closed loop, allowed [`FeedbackParams::replan_xy`] off its path,
-/// pushes the slider into.
-pub const MARGIN: f64 = 0.015;
-
-/// `p` with every contact's collision body (slider and pusher) grown by `m` (each convex part
-/// offset outward, its corners cut: a polygon between the part grown by `m·cos(π/n)`-ish and
-/// by `m`): its plans keep about `m` from every obstacle and wall. Only the collision bodies
-/// change (mechanics, costs, goal and transits are `p`'s).
-pub fn with_margin(p: &Problem, m: f64) -> Problem {
-    let mut q = p.clone();
-    let slider_parts: Vec<Vec<V2>> = Obstacle::parts(&p.slider.vertices)
-        .map(|ps| ps.into_iter().map(|o| o.vertices).collect())
-        .unwrap_or_else(|| vec![p.slider.vertices.clone()]);
-    for c in &mut q.contacts {
-        let mut parts: Vec<Vec<V2>> = slider_parts.iter().map(|v| grown(v, m)).collect();
-        if !c.footprint.is_empty() {
-            parts.push(grown(&c.footprint, m));
-        }
-        c.body = Body::new(&parts);
-        c.swept = c.steps.iter().map(|xi| c.body.swept(xi)).collect();
-        c.fine_swept = c.fine_steps.iter().map(|xi| c.body.swept(xi)).collect();
-    }
-    q
-}
-
-/// The convex polygon `v` grown by `m`: each vertex replaced by its two neighbouring edges'
-/// points moved out along their normals.
-fn grown(v: &[V2], m: f64) -> Vec<V2> {
-    let ccw = crate::mechanics::signed_area(v) >= 0.0;
-    let n = v.len();
-    let normal = |i: usize| {
-        let d = v[(i + 1) % n] - v[i];
-        let out = V2::new(d.y, -d.x);
-        let out = if ccw { out } else { -out };
-        out / out.norm().max(1e-12)
-    };
-    let mut out = Vec::with_capacity(2 * n);
-    for i in 0..n {
-        let (prev, next) = (normal((i + n - 1) % n), normal(i));
-        out.push(v[i] + prev * m);
-        out.push(v[i] + next * m);
-    }
-    out
-}
-
-/// How far from the measured pose [`plan_from`] looks for a free start, m.
-const NUDGE: f64 = 0.012;
-/// The clearance that start needs, m.
-const NUDGE_CLEARANCE: f64 = 0.002;
-
-/// A plan for `p` that ends in the inner part of its goal neighbourhood where one exists
-/// ([`GOAL_SHRINK`]), exactly on the goal where the exact finish (§4.5) exists; `None` when no
-/// plan reaches even the whole neighbourhood.
-pub fn plan_inner(p: &Problem) -> Option<Plan> {
-    for shrink in GOAL_SHRINK {
-        let mut q = p.clone();
-        q.params.goal_xy *= shrink.0;
-        q.params.goal_theta *= shrink.1;
-        if shrink.0 < 1.0 {
-            // A tighter goal is a preference: a short search, not an exhausted one.
-            q.params.max_nodes = q.params.max_nodes.min(INNER_NODES);
-        }
-        let pl = plan_stable(&q);
-        if pl.found {
-            return Some(finish_exactly(&q, &pl).unwrap_or(pl));
-        }
-    }
-    None
-}
-
-/// Nodes a search for the inner part of the goal may expand before the next, wider goal is
-/// tried.
-const INNER_NODES: usize = 20_000;
-
-/// The goal neighbourhoods [`plan_inner`] tries, as shares of the task's (x-y, θ): a plan
-/// ends anywhere in its neighbourhood, often on its edge, where the camera's noise and the
-/// next push's error decide; so a plan aims at the inner part first.
-const GOAL_SHRINK: [(f64, f64); 3] = [(0.4, 0.5), (0.7, 0.75), (1.0, 1.0)];
-
-/// Drive `plan` closed loop on `io` (the slider is the object `slider`; the robot starts flush
-/// on the plan's first contact). Returns what it did; `reached` is the camera's verdict.
+/// Drive `plan` closed loop on `io` (the slider is the object `slider`; the robot starts
+/// anywhere free, at any heading: it first drives to the plan's first contact,
+/// [`go_to_first_contact`]). Returns what it did; `reached` is the camera's verdict.
 pub fn execute_closed_loop(
     p: &Problem,
     plan: &Plan,
@@ -482,8 +351,40 @@ pub fn execute_closed_loop(
         path: vec![[s0.x, s0.y]],
         failure: None,
     };
-    let mut contact = first.contact;
+    // The robot may start anywhere: when it has no way to the plan's first edge, a plan from
+    // the observed pose that starts on an edge it can reach.
     let mut current = plan.clone();
+    let (r0, _) = observe(io)?;
+    let reachable =
+        |c: usize| on_edge(p, c, &r0, &s0) || start_path(p, V2::new(r0.x, r0.y), &s0, c).is_some();
+    if !reachable(first.contact) {
+        let alt = (0..p.contacts.len())
+            .filter(|c| reachable(*c))
+            .find_map(|c| {
+                let mut q = p.clone();
+                q.start = s0;
+                q.start_contact = Some(c);
+                run.replans += 1;
+                plan_clear(&q).filter(|pl| pl.steps.first().is_some_and(|st| st.contact == c))
+            });
+        match alt {
+            Some(pl) => current = pl,
+            None => {
+                run.failure = Some(
+                    "no transit path from the robot's start to an edge with a plan".to_string(),
+                );
+                return Ok(run);
+            }
+        }
+    }
+    let first = current.steps[0].contact;
+    if !go_to_first_contact(p, first, io)? {
+        run.failure = Some(format!(
+            "no transit path from the robot's start to contact {first}"
+        ));
+        return Ok(run);
+    }
+    let mut contact = first;
     // Bounds of the current plan: widened once when no plan exists from the measured pose and
     // the current one is followed on.
     let mut relax = 1.0;
