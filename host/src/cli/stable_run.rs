@@ -3,7 +3,9 @@
 //! or open loop, as the paper drives them, with `--open-loop` — on the in-process simulated
 //! robot, perturbed with `--perturb` (the scene's `[perturb]` ranges, seeded by `--seed` and
 //! the trial number); through a serial port and a camera with `--hil` (the built-in target on
-//! a pty with its rendered camera) or `--port`/`--camera` (a real robot).
+//! a pty with its rendered camera) or `--port`/`--camera` (a real robot). `eval stable --random
+//! N` runs the random scenes of `planner::stable::random_scene` (diff-drive or car) instead of
+//! one scene.
 
 use clap::{Args, Subcommand};
 

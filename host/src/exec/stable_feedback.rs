@@ -12,7 +12,13 @@
 //!   ([`stable_curvatures`]);
 //! - past a bound (lateral or heading error), or at the end of the path outside the goal, it
 //!   re-plans from the measured slider pose (the planner takes milliseconds), and prefers the
-//!   plan's exact finish (§4.5) when there is one;
+//!   plan's exact finish (§4.5) when there is one; re-plans keep a margin from the obstacles
+//!   where they can, may start on any pushing edge, and start from a free pose next to a
+//!   slider that grazes an obstacle ([`crate::exec::stable_replan`]);
+//! - the robot may start anywhere, at any heading: it first drives to the plan's first edge
+//!   ([`crate::exec::stable_start`]), or re-plans onto an edge it can reach;
+//! - a car's corrections turn no tighter than its turning radius (its pushes are forward only,
+//!   as every push here);
 //! - when the plate has lost the edge (the slider turned or slid on it beyond a bound), it
 //!   backs off and re-acquires the edge with the transit code's approach
 //!   ([`crate::exec::stable::approach`]), then re-plans.

@@ -44,21 +44,30 @@ pub fn plan_from(p: &Problem, s: Pose, ci: usize) -> Option<Plan> {
     if free(&s) {
         return None;
     }
-    // Nearest first: rings of 2 mm, 16 directions, the heading as measured or ±2°.
+    // Nearest first: rings of 2 mm, 16 directions, the heading as measured or ±2°; the first
+    // [`NUDGE_TRIES`] free poses are tried.
+    let mut tried = 0;
     for k in 1..=(NUDGE / 0.002).round() as usize {
         let r = 0.002 * k as f64;
         for j in 0..16 {
             let a = j as f64 * std::f64::consts::TAU / 16.0;
             for dth in [0.0, 2f64.to_radians(), -(2f64.to_radians())] {
                 let q = Pose::new(s.x + r * a.cos(), s.y + r * a.sin(), s.theta + dth);
-                if free(&q) {
-                    tracing::info!(
-                        "stable closed loop: the slider touches an obstacle; planning from \
-                         {:.1} mm, {:.0}° away",
-                        r * 1e3,
-                        dth.to_degrees()
-                    );
-                    return attempt(q);
+                if !free(&q) {
+                    continue;
+                }
+                tracing::info!(
+                    "stable closed loop: the slider touches an obstacle; planning from {:.1} mm, \
+                     {:.0}° away",
+                    r * 1e3,
+                    dth.to_degrees()
+                );
+                if let Some(pl) = attempt(q) {
+                    return Some(pl);
+                }
+                tried += 1;
+                if tried >= NUDGE_TRIES {
+                    return None;
                 }
             }
         }
@@ -78,7 +87,7 @@ pub fn plan_clear(p: &Problem) -> Option<Plan> {
 /// grazes a wall is one the closed loop, allowed
 /// [`crate::exec::stable_feedback::FeedbackParams::replan_xy`] off its path,
 /// pushes the slider into.
-pub const MARGIN: f64 = 0.015;
+pub const MARGIN: f64 = 0.025;
 
 /// `p` with every contact's collision body (slider and pusher) grown by `m` (each convex part
 /// offset outward, its corners cut: a polygon between the part grown by `m·cos(π/n)`-ish and
@@ -122,7 +131,9 @@ fn grown(v: &[V2], m: f64) -> Vec<V2> {
 }
 
 /// How far from the measured pose [`plan_from`] looks for a free start, m.
-const NUDGE: f64 = 0.012;
+const NUDGE: f64 = 0.02;
+/// How many free poses near it [`plan_from`] plans from before it gives up.
+const NUDGE_TRIES: usize = 6;
 /// The clearance that start needs, m.
 const NUDGE_CLEARANCE: f64 = 0.002;
 
