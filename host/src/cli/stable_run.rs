@@ -3,7 +3,9 @@
 //! or open loop, as the paper drives them, with `--open-loop` — on the in-process simulated
 //! robot, perturbed with `--perturb` (the scene's `[perturb]` ranges, seeded by `--seed` and
 //! the trial number); through a serial port and a camera with `--hil` (the built-in target on
-//! a pty with its rendered camera) or `--port`/`--camera` (a real robot).
+//! a pty with its rendered camera) or `--port`/`--camera` (a real robot). `eval stable --random
+//! N` runs the random scenes of `planner::stable::random_scene` (diff-drive or car) instead of
+//! one scene.
 
 use clap::{Args, Subcommand};
 
@@ -21,9 +23,9 @@ pub enum RunCommand {
 pub struct StableRunArgs {
     /// A preset (fig13, fig15, fig16, fig17, fig18: its robot-scale version, the robot's plate
     /// pushing on edge 0) or a scene file with a `[stable]` section whose pusher is a
-    /// `diff-drive`.
+    /// `diff-drive`. (`eval stable` takes --random instead.)
     #[arg(long)]
-    pub scene: String,
+    pub scene: Option<String>,
     /// Perturb the simulated world: start pose, frictions, centre of friction, wheel slip and
     /// camera noise drawn from the scene's `[perturb]` ranges (defaults: ±5°, ±10 mm, ±30 %,
     /// 5 mm, ±0.5 %, 1 mm and 0.5°), seeded by --seed and the trial number. The planner keeps
@@ -50,6 +52,10 @@ pub struct StableRunArgs {
     /// With --hil: simulated seconds per wall second.
     #[arg(long = "sim-speed", default_value_t = 8.0)]
     pub speed: f64,
+    /// Write each trial's drawing (the plan, and the slider's executed path over it) into this
+    /// folder as `trial-N.svg`.
+    #[arg(long)]
+    pub svg: Option<std::path::PathBuf>,
 }
 
 /// `pushbot eval stable`.
@@ -60,6 +66,16 @@ pub struct StableEvalArgs {
     /// Number of trials (trials --trial … --trial + N − 1).
     #[arg(long, default_value_t = 20)]
     pub trials: u64,
+    /// Instead of --scene: N random scenes (`planner::stable::random_scene`, seeds --trial …
+    /// --trial + N − 1), each planned with the nominal model and run once (its trial number is
+    /// its seed), the robot starting at a free pose of any heading.
+    #[arg(long, conflicts_with = "scene")]
+    pub random: Option<u64>,
+    /// The random scenes' pusher: diff-drive (the simulated robot itself) or car (mapped onto
+    /// it: its rear axle on the robot's wheel axle; forward-only pushes no tighter than its
+    /// turning radius).
+    #[arg(long, default_value = "diff-drive", requires = "random")]
+    pub pusher: String,
 }
 
 impl StableRunArgs {
@@ -87,7 +103,12 @@ impl StableRunArgs {
 /// Run `pushbot run stable`.
 pub fn run(g: &Global, cmd: RunCommand) -> CliResult {
     let RunCommand::Stable(a) = cmd;
-    let e = StableEvalArgs { run: a, trials: 1 };
+    let e = StableEvalArgs {
+        run: a,
+        trials: 1,
+        random: None,
+        pusher: "diff-drive".into(),
+    };
     eval_or_run(g, &e, true)
 }
 
@@ -98,6 +119,14 @@ pub fn eval(g: &Global, a: &StableEvalArgs) -> CliResult {
             "--trials must be 1..=10000, not {}",
             a.trials
         )));
+    }
+    if let Some(n) = a.random {
+        if !(1..=10_000).contains(&n) {
+            return Err(CliError::bad_input(format!(
+                "--random must be 1..=10000, not {n}"
+            )));
+        }
+        return eval_random(g, a, n);
     }
     eval_or_run(g, a, false)
 }
@@ -111,7 +140,12 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     use crate::experiments::stable_trials::{StableTask, StableTrial, run_trial, run_trial_live};
     let r = &a.run;
     r.check()?;
-    let task = StableTask::load(&r.scene).map_err(|e| CliError::bad_input(format!("{e:#}")))?;
+    let Some(name) = &r.scene else {
+        return Err(CliError::bad_input(
+            "give --scene (a preset or a scene file), or --random N with `eval stable`",
+        ));
+    };
+    let task = StableTask::load(name).map_err(|e| CliError::bad_input(format!("{e:#}")))?;
     if let (Some(port), Some(camera)) = (&r.port, &r.camera) {
         drop(crate::link::transport::open(port).map_err(|e| CliError::bad_input(format!("{e}")))?);
         crate::exec::grabber::FrameGrabber::open(camera, 30.0)
@@ -121,7 +155,7 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     let pb = super::progress_bar(g, trials.len() as u64);
     pb.set_message(format!(
         "{} {} loop{}",
-        r.scene,
+        name,
         if r.open_loop { "open" } else { "closed" },
         if r.perturb { ", perturbed" } else { "" }
     ));
@@ -146,11 +180,14 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     for (t, res) in trials.iter().zip(results) {
         rows.push(res.map_err(|e| CliError::Failed(e.context(format!("trial {t}"))))?);
     }
+    if let Some(dir) = &r.svg {
+        write_svgs(dir, &task, &rows)?;
+    }
     let reached = rows.iter().filter(|t| t.reached).count();
     let n = rows.len();
     let mean = |f: &dyn Fn(&StableTrial) -> f64| rows.iter().map(f).sum::<f64>() / n as f64;
     let summary = json!({
-        "scene": r.scene,
+        "scene": name,
         "closed_loop": !r.open_loop,
         "perturbed": r.perturb,
         "seed": g.seed,
@@ -168,7 +205,7 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     } else {
         println!(
             "{} ({} loop{}, seed {}): goal ±{:.0} mm, ±{:.1}°",
-            r.scene,
+            name,
             if r.open_loop { "open" } else { "closed" },
             if r.perturb { ", perturbed" } else { "" },
             g.seed,
@@ -205,8 +242,151 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     })
 }
 
+/// Each trial's plan with its executed path, as `dir/trial-N.svg`.
+#[cfg(feature = "sim")]
+fn write_svgs(
+    dir: &std::path::Path,
+    task: &crate::experiments::stable_trials::StableTask,
+    rows: &[crate::experiments::stable_trials::StableTrial],
+) -> Result<(), CliError> {
+    use crate::planner::stable::svg::render_executed;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::bad_input(format!("--svg {}: {e}", dir.display())))?;
+    for t in rows {
+        let f = dir.join(format!("trial-{}.svg", t.trial));
+        std::fs::write(
+            &f,
+            render_executed(&task.problem, Some(&task.plan), &t.path),
+        )
+        .map_err(|e| CliError::bad_input(format!("{}: {e}", f.display())))?;
+    }
+    Ok(())
+}
+
 #[cfg(not(feature = "sim"))]
 fn eval_or_run(_g: &Global, a: &StableEvalArgs, _single: bool) -> CliResult {
+    a.run.check()?;
+    Err(super::no_simulated_target())
+}
+
+/// `pushbot eval stable --random N`: each random scene planned with the nominal model and run
+/// once on the simulated robot (perturbed with --perturb); per scene whether a plan exists and
+/// what the run did, and the share reached of all scenes and of those with a plan.
+#[cfg(feature = "sim")]
+fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
+    use rayon::prelude::*;
+    use serde_json::json;
+
+    use super::Status;
+    use crate::experiments::stable_trials::{StableTask, StableTrial, run_trial, run_trial_live};
+    use crate::planner::stable::random_scene::RandomPusher;
+    let r = &a.run;
+    r.check()?;
+    if r.port.is_some() {
+        return Err(CliError::bad_input(
+            "--random builds simulated scenes; a real robot's table is what it is (no --port)",
+        ));
+    }
+    let pusher = RandomPusher::parse(&a.pusher).map_err(|e| CliError::bad_input(format!("{e}")))?;
+    if !matches!(pusher, RandomPusher::DiffDrive | RandomPusher::Car) {
+        return Err(CliError::bad_input(format!(
+            "--pusher {}: the simulated robot drives diff-drive and car scenes",
+            a.pusher
+        )));
+    }
+    let seeds: Vec<u64> = (r.trial..r.trial + n).collect();
+    let pb = super::progress_bar(g, seeds.len() as u64);
+    pb.set_message(format!("random {} scenes", pusher.name()));
+    let one = |seed: u64| -> anyhow::Result<(u64, Option<StableTrial>)> {
+        let out = match StableTask::random(seed, pusher)? {
+            None => None,
+            Some(task) => {
+                let pert = task.perturbation(g.seed, seed, r.perturb);
+                Some(if r.hil {
+                    run_trial_live(&task, seed, g.seed, pert, !r.open_loop, None, r.speed)?
+                } else {
+                    run_trial(&task, seed, g.seed, pert, !r.open_loop)?
+                })
+            }
+        };
+        pb.inc(1);
+        Ok((seed, out))
+    };
+    let results: Vec<anyhow::Result<(u64, Option<StableTrial>)>> = if r.hil {
+        seeds.iter().map(|s| one(*s)).collect()
+    } else {
+        seeds.par_iter().map(|s| one(*s)).collect()
+    };
+    pb.finish_and_clear();
+    let mut rows = Vec::new();
+    for (s, res) in seeds.iter().zip(results) {
+        rows.push(res.map_err(|e| CliError::Failed(e.context(format!("random scene {s}"))))?);
+    }
+    let planned = rows.iter().filter(|(_, t)| t.is_some()).count();
+    let reached = rows
+        .iter()
+        .filter(|(_, t)| t.as_ref().is_some_and(|t| t.reached))
+        .count();
+    let share = |k: usize, of: usize| if of == 0 { 0.0 } else { k as f64 / of as f64 };
+    let summary = json!({
+        "random": n,
+        "pusher": pusher.name(),
+        "closed_loop": !r.open_loop,
+        "perturbed": r.perturb,
+        "seed": g.seed,
+        "trials": rows.len(),
+        "planned": planned,
+        "reached": reached,
+        "reached_share": share(reached, rows.len()),
+        "reached_share_of_planned": share(reached, planned),
+        "contact_losses": rows.iter().filter_map(|(_, t)| t.as_ref()).map(|t| t.contact_losses).sum::<usize>(),
+    });
+    if g.json {
+        let scenes: Vec<_> = rows
+            .iter()
+            .map(|(s, t)| json!({"scene": s, "planned": t.is_some(), "trial": t}))
+            .collect();
+        println!("{}", json!({ "summary": summary, "scenes": scenes }));
+    } else {
+        println!(
+            "random {} scenes {}…{} ({} loop{}, seed {})",
+            pusher.name(),
+            r.trial,
+            r.trial + n - 1,
+            if r.open_loop { "open" } else { "closed" },
+            if r.perturb { ", perturbed" } else { "" },
+            g.seed
+        );
+        println!("scene  plan  reached  error mm   error °  re-plans  contact losses");
+        for (s, t) in &rows {
+            match t {
+                None => println!("{s:5}  none"),
+                Some(t) => println!(
+                    "{s:5}  yes   {:7}  {:8.1}  {:8.2}  {:8}  {:14}{}",
+                    if t.reached { "yes" } else { "NO" },
+                    t.final_error_m * 1e3,
+                    t.final_error_deg,
+                    t.replans,
+                    t.contact_losses,
+                    t.failure
+                        .as_ref()
+                        .map_or(String::new(), |f| format!("  ({f})"))
+                ),
+            }
+        }
+        println!(
+            "reached {reached} of {} scenes ({:.0} %); a plan exists in {planned}: reached {:.0} % \
+             of those",
+            rows.len(),
+            100.0 * share(reached, rows.len()),
+            100.0 * share(reached, planned)
+        );
+    }
+    Ok(Status::Success)
+}
+
+#[cfg(not(feature = "sim"))]
+fn eval_random(_g: &Global, a: &StableEvalArgs, _n: u64) -> CliResult {
     a.run.check()?;
     Err(super::no_simulated_target())
 }

@@ -30,6 +30,8 @@ pub mod rearrange;
 pub mod record;
 pub mod stable;
 pub mod stable_feedback;
+pub mod stable_replan;
+pub mod stable_start;
 pub mod view;
 
 pub use live::{LiveOptions, LiveRobot};

@@ -12,7 +12,13 @@
 //!   ([`stable_curvatures`]);
 //! - past a bound (lateral or heading error), or at the end of the path outside the goal, it
 //!   re-plans from the measured slider pose (the planner takes milliseconds), and prefers the
-//!   plan's exact finish (§4.5) when there is one;
+//!   plan's exact finish (§4.5) when there is one; re-plans keep a margin from the obstacles
+//!   where they can, may start on any pushing edge, and start from a free pose next to a
+//!   slider that grazes an obstacle ([`crate::exec::stable_replan`]);
+//! - the robot may start anywhere, at any heading: it first drives to the plan's first edge
+//!   ([`crate::exec::stable_start`]), or re-plans onto an edge it can reach;
+//! - a car's corrections turn no tighter than its turning radius (its pushes are forward only,
+//!   as every push here);
 //! - when the plate has lost the edge (the slider turned or slid on it beyond a bound), it
 //!   backs off and re-acquires the edge with the transit code's approach
 //!   ([`crate::exec::stable::approach`]), then re-plans.
@@ -24,11 +30,13 @@ use anyhow::{Context, Result, bail};
 
 use crate::exec::io::RobotIo;
 use crate::exec::stable::{approach, drive_transit, flush_pose, observe};
+use crate::exec::stable_replan::{plan_clear, plan_from};
+use crate::exec::stable_start::{go_to_first_contact, on_edge, start_path};
 use crate::mechanics::{V2, V3, cross};
-use crate::planner::stable::exact::finish_exactly;
+use crate::planner::stable::pusher::PusherKind;
 use crate::planner::stable::robot::{SPEED, robot_in_slider};
 use crate::planner::stable::transit::transit;
-use crate::planner::stable::{Plan, Pose, Problem, angle_diff, plan as plan_stable};
+use crate::planner::stable::{Plan, Pose, Problem, angle_diff};
 
 /// Settings of the closed loop.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -64,11 +72,11 @@ impl Default for FeedbackParams {
             k_lateral: 100.0,
             k_heading: 20.0,
             stable_margin: 0.9,
-            replan_xy: 0.03,
-            replan_theta: 8f64.to_radians(),
+            replan_xy: 0.02,
+            replan_theta: 5f64.to_radians(),
             lost_xy: 0.012,
             lost_theta: 8f64.to_radians(),
-            max_replans: 12,
+            max_replans: 20,
             max_losses: 4,
         }
     }
@@ -190,6 +198,9 @@ enum Tracked {
     Lost,
     /// The slider came into the goal neighbourhood with margin before the path ended.
     InGoal,
+    /// No transit path leads from the plate's edge to the next segment's from where the
+    /// slider is: re-plan.
+    NoTransit,
 }
 
 /// Whether `q` is inside the goal neighbourhood by a margin for the camera's noise.
@@ -212,6 +223,14 @@ fn track(
     let ci = seg.contact;
     let (k_right, k_left) = stable_curvatures(p, ci);
     let (k_min, k_max) = (k_right * fp.stable_margin, k_left * fp.stable_margin);
+    // A car turns no tighter than its radius (Fig. 14): its plan's pushes do not, nor may the
+    // corrections.
+    let k_car = match p.pusher.kind {
+        PusherKind::Car { min_turning_radius } if min_turning_radius > 0.0 => {
+            1.0 / min_turning_radius
+        }
+        _ => f64::INFINITY,
+    };
     let n = seg.pts.len();
     let total = seg.cum[n - 1];
     // Start from the nearest point of the whole path (it may be taken up half-way).
@@ -285,7 +304,8 @@ fn track(
         // pushes, on the set's boundary); the corrections stay inside the set.
         let k_ref = seg.kappa[idx];
         let kappa = (k_ref - fp.k_lateral * e - fp.k_heading * th_e.sin())
-            .clamp(k_min.min(k_ref), k_max.max(k_ref));
+            .clamp(k_min.min(k_ref), k_max.max(k_ref))
+            .clamp(-k_car, k_car);
         let ds = fp.control_step.min(remaining.max(0.002));
         let dur = ds / SPEED;
         io.drive(SPEED, kappa * SPEED, dur)
@@ -303,50 +323,19 @@ fn reacquire(p: &Problem, ci: usize, io: &mut dyn RobotIo) -> Result<()> {
     approach(p, ci, io).context("re-acquiring the edge")
 }
 
-/// A plan from the measured slider pose `s` with the plate on contact `ci`: the exact finish
-/// when there is one (it ends on the goal itself, not on the neighbourhood's edge).
+/// A plan from the measured slider pose `s` with the plate on contact `ci` ([`plan_from`]),
+/// counted in `run`.
 fn replan(p: &Problem, s: Pose, ci: usize, run: &mut FeedbackRun) -> Option<Plan> {
     let t0 = std::time::Instant::now();
-    let mut q = p.clone();
-    q.start = s;
-    q.start_contact = Some(ci);
-    let found = plan_inner(&q);
+    let found = plan_from(p, s, ci);
     run.replan_ms += t0.elapsed().as_secs_f64() * 1e3;
     run.replans += 1;
     found
 }
 
-/// A plan for `p` that ends in the inner part of its goal neighbourhood where one exists
-/// ([`GOAL_SHRINK`]), exactly on the goal where the exact finish (§4.5) exists; `None` when no
-/// plan reaches even the whole neighbourhood.
-pub fn plan_inner(p: &Problem) -> Option<Plan> {
-    for shrink in GOAL_SHRINK {
-        let mut q = p.clone();
-        q.params.goal_xy *= shrink.0;
-        q.params.goal_theta *= shrink.1;
-        if shrink.0 < 1.0 {
-            // A tighter goal is a preference: a short search, not an exhausted one.
-            q.params.max_nodes = q.params.max_nodes.min(INNER_NODES);
-        }
-        let pl = plan_stable(&q);
-        if pl.found {
-            return Some(finish_exactly(&q, &pl).unwrap_or(pl));
-        }
-    }
-    None
-}
-
-/// Nodes a search for the inner part of the goal may expand before the next, wider goal is
-/// tried.
-const INNER_NODES: usize = 20_000;
-
-/// The goal neighbourhoods [`plan_inner`] tries, as shares of the task's (x-y, θ): a plan
-/// ends anywhere in its neighbourhood, often on its edge, where the camera's noise and the
-/// next push's error decide; so a plan aims at the inner part first.
-const GOAL_SHRINK: [(f64, f64); 3] = [(0.4, 0.5), (0.7, 0.75), (1.0, 1.0)];
-
-/// Drive `plan` closed loop on `io` (the slider is the object `slider`; the robot starts flush
-/// on the plan's first contact). Returns what it did; `reached` is the camera's verdict.
+/// Drive `plan` closed loop on `io` (the slider is the object `slider`; the robot starts
+/// anywhere free, at any heading: it first drives to the plan's first contact,
+/// [`go_to_first_contact`]). Returns what it did; `reached` is the camera's verdict.
 pub fn execute_closed_loop(
     p: &Problem,
     plan: &Plan,
@@ -368,8 +357,40 @@ pub fn execute_closed_loop(
         path: vec![[s0.x, s0.y]],
         failure: None,
     };
-    let mut contact = first.contact;
+    // The robot may start anywhere: when it has no way to the plan's first edge, a plan from
+    // the observed pose that starts on an edge it can reach.
     let mut current = plan.clone();
+    let (r0, _) = observe(io)?;
+    let reachable =
+        |c: usize| on_edge(p, c, &r0, &s0) || start_path(p, V2::new(r0.x, r0.y), &s0, c).is_some();
+    if !reachable(first.contact) {
+        let alt = (0..p.contacts.len())
+            .filter(|c| reachable(*c))
+            .find_map(|c| {
+                let mut q = p.clone();
+                q.start = s0;
+                q.start_contact = Some(c);
+                run.replans += 1;
+                plan_clear(&q).filter(|pl| pl.steps.first().is_some_and(|st| st.contact == c))
+            });
+        match alt {
+            Some(pl) => current = pl,
+            None => {
+                run.failure = Some(
+                    "no transit path from the robot's start to an edge with a plan".to_string(),
+                );
+                return Ok(run);
+            }
+        }
+    }
+    let first = current.steps[0].contact;
+    if !go_to_first_contact(p, first, io)? {
+        run.failure = Some(format!(
+            "no transit path from the robot's start to contact {first}"
+        ));
+        return Ok(run);
+    }
+    let mut contact = first;
     // Bounds of the current plan: widened once when no plan exists from the measured pose and
     // the current one is followed on.
     let mut relax = 1.0;
@@ -394,9 +415,13 @@ pub fn execute_closed_loop(
                     Some(t) => t,
                     None => {
                         let (_, s) = observe(io)?;
-                        transit(p, &s, contact, seg.contact, 0).ok_or_else(|| {
-                            anyhow::anyhow!("no transit path {contact} → {}", seg.contact)
-                        })?
+                        match transit(p, &s, contact, seg.contact, 0) {
+                            Some(t) => t,
+                            None => {
+                                outcome = Tracked::NoTransit;
+                                break;
+                            }
+                        }
                     }
                 };
                 drive_transit(p, &tr, io)

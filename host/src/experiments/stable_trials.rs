@@ -11,11 +11,18 @@ use pushbot_world::scene::perturb::Perturb;
 
 use crate::exec::io::RobotIo;
 use crate::exec::stable::execute;
-use crate::exec::stable_feedback::{FeedbackParams, execute_closed_loop, plan_inner};
-use crate::planner::stable::presets::{PRESETS, Scene as StableScene, load_scene};
+use crate::exec::stable_feedback::{FeedbackParams, execute_closed_loop};
+use crate::exec::stable_replan::plan_clear;
+use crate::exec::stable_start::start_path;
+use crate::mechanics::V2;
+use crate::planner::stable::collision::Body;
+use crate::planner::stable::presets::{CostOverride, PRESETS, Scene as StableScene, load_scene};
+use crate::planner::stable::random_scene::{RandomPusher, WEIGHT, random_scene};
 use crate::planner::stable::robot::{
-    SPEED, robot_problem, robot_problem_in, robot_problem_scene, robot_start, sim_scene,
+    PLATE_OFFSET, PLATE_WIDTH, SPEED, robot_problem, robot_problem_in, robot_problem_scene,
+    robot_start, sim_scene,
 };
+use crate::planner::stable::transit::point_segment_distance;
 use crate::planner::stable::{Plan, Pose, Problem, angle_diff, plan};
 use crate::sim::robot::{SimRobot, SimRobotOptions};
 
@@ -67,10 +74,12 @@ pub struct StableTask {
     /// Its problem.
     pub problem: Problem,
     /// The plan (found), made with the nominal model for the inner part of the goal
-    /// neighbourhood ([`plan_inner`]).
+    /// neighbourhood, clear of the obstacles where it can be ([`plan_clear`]).
     pub plan: Plan,
     /// The perturbation ranges: the scene's `[perturb]` or the defaults.
     pub ranges: Perturb,
+    /// Where the robot starts (axle centre, heading): `None` flush on the plan's first contact.
+    pub robot_start: Option<[f64; 3]>,
 }
 
 impl StableTask {
@@ -99,7 +108,7 @@ impl StableTask {
             // and the robot's plate.
             robot_problem_scene(name)?
         };
-        let Some(pl) = plan_inner(&problem).filter(|pl| !pl.steps.is_empty()) else {
+        let Some(pl) = plan_clear(&problem).filter(|pl| !pl.steps.is_empty()) else {
             bail!(
                 "scene {name}: no plan of stable pushes for the plated robot ({} configurations \
                  expanded)",
@@ -112,13 +121,95 @@ impl StableTask {
             problem,
             plan: pl,
             ranges: world.perturb.unwrap_or_default(),
+            robot_start: None,
         })
     }
 
-    /// The simulated scene: the robot's plate flush on the plan's first contact.
+    /// The random scene of `seed` ([`random_scene`]) for `pusher` on the simulated robot,
+    /// planned with the nominal model as `pushbot bench stable --random` plans it (A* weighted by
+    /// [`WEIGHT`]); `Ok(None)` when no plan exists. The robot starts at a free pose of any
+    /// heading 0.2–0.45 m from the slider ([`robot_start_pose`]).
+    ///
+    /// The simulated robot is a differential drive with a 12 cm plate 6 cm ahead of its axle:
+    /// the random diff-drive pusher is that robot. The random car (plate 12 cm, rear axle 10 cm
+    /// behind it, 14 cm deep) is mapped onto it: its rear axle where the robot's wheel axle is
+    /// (6 cm) and the robot's body (10 cm), kept are its turning radius and forward-only
+    /// pushing; the planner plans that car. (A differential drive's rotation centres lie on its
+    /// axle line, so only a car whose rear axle is that line is a subset of it.)
+    pub fn random(seed: u64, pusher: RandomPusher) -> Result<Option<StableTask>> {
+        if !matches!(pusher, RandomPusher::DiffDrive | RandomPusher::Car) {
+            bail!(
+                "random {} scenes: the simulated robot drives diff-drive and car scenes",
+                pusher.name()
+            );
+        }
+        let rs = random_scene(seed, pusher)?;
+        let mut scene = rs.scene()?;
+        if pusher == RandomPusher::Car {
+            scene.pusher.axle_offset = Some(PLATE_OFFSET);
+            scene.pusher.depth = Some(PLATE_OFFSET + 0.04);
+            scene.pusher.width = Some(PLATE_WIDTH);
+            scene.pusher.plate_width = Some(PLATE_WIDTH);
+        }
+        if pusher == RandomPusher::Car {
+            // The mapped car may have no usable push on an edge the generator offered (its
+            // rotation centres moved): that edge is dropped.
+            let all = scene.task.edges.clone();
+            scene.task.edges = all
+                .into_iter()
+                .filter(|e| {
+                    let mut one = scene.clone();
+                    one.task.edges = vec![*e];
+                    one.task.start_edge = None;
+                    one.problem(CostOverride::default()).is_ok()
+                })
+                .collect();
+            if scene.task.edges.is_empty() {
+                return Ok(None);
+            }
+            if scene
+                .task
+                .start_edge
+                .is_some_and(|e| !scene.task.edges.contains(&e))
+            {
+                scene.task.start_edge = None;
+            }
+        }
+        let mut problem = scene.problem(CostOverride::default())?;
+        problem.params.weight = WEIGHT;
+        if (problem.pusher.axle_offset - PLATE_OFFSET).abs() > 1e-9
+            || problem.pusher.plate_width != Some(PLATE_WIDTH)
+        {
+            bail!(
+                "{}: the pusher's plate ({:?} m, {} m ahead of the axle) is not the simulated \
+                 robot's ({PLATE_WIDTH} m, {PLATE_OFFSET} m)",
+                rs.name(),
+                problem.pusher.plate_width,
+                problem.pusher.axle_offset
+            );
+        }
+        let Some(pl) = plan_clear(&problem).filter(|pl| !pl.steps.is_empty()) else {
+            return Ok(None);
+        };
+        let robot_start = robot_start_pose(&problem, pl.steps[0].contact, seed);
+        Ok(Some(StableTask {
+            name: rs.name(),
+            scene,
+            problem,
+            plan: pl,
+            ranges: Perturb::default(),
+            robot_start,
+        }))
+    }
+
+    /// The simulated scene: the robot at [`StableTask::robot_start`], else its plate flush on
+    /// the plan's first contact.
     pub fn sim_scene(&self) -> Result<pushbot_world::Scene> {
-        let start = robot_start(&self.problem, &self.plan)
-            .ok_or_else(|| anyhow!("the plan has no step"))?;
+        let start = match self.robot_start {
+            Some(r) => r,
+            None => robot_start(&self.problem, &self.plan)
+                .ok_or_else(|| anyhow!("the plan has no step"))?,
+        };
         sim_scene(&self.scene, &self.problem, start, 1)
     }
 
@@ -136,6 +227,53 @@ impl StableTask {
         };
         Perturbation::draw(&ranges, "slider", seed, trial)
     }
+}
+
+/// A start for the robot's axle centre 0.2–0.45 m from the slider's start, of any heading,
+/// drawn from `seed`: its turning disk (with 3 cm to spare, for the perturbed start) clear of
+/// the table's edges, the obstacles and the slider, and a way for it from there to contact
+/// `first` ([`start_path`]; the start heading is free, the position not: an enclosed pocket
+/// has no way out). `None` (flush on the first contact) when 500 draws find none.
+pub fn robot_start_pose(p: &Problem, first: usize, seed: u64) -> Option<[f64; 3]> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ 0x5747_4152);
+    let r = p.pusher.turning_radius_disk() + 0.03;
+    let disk: Vec<V2> = (0..16)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / 16.0;
+            V2::new(r * a.cos(), r * a.sin())
+        })
+        .collect();
+    let body = Body::new(&[disk]);
+    let slider: Vec<V2> = p
+        .slider
+        .vertices
+        .iter()
+        .map(|v| p.start.apply(*v))
+        .collect();
+    let n = slider.len();
+    for _ in 0..500 {
+        let (a, d) = (
+            rng.random_range(-std::f64::consts::PI..std::f64::consts::PI),
+            rng.random_range(0.2..0.45),
+        );
+        let c = V2::new(p.start.x + d * a.cos(), p.start.y + d * a.sin());
+        let heading = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+        let (w, h) = p.world.table;
+        if c.x < r || c.y < r || c.x > w - r || c.y > h - r {
+            continue;
+        }
+        // Outside the slider (d exceeds its radius) and clear of its edges.
+        let off_slider = d > p.slider.radius()
+            && (0..n).all(|i| point_segment_distance(c, slider[i], slider[(i + 1) % n]) > r);
+        if off_slider
+            && body.free_at(&p.world, &Pose::new(c.x, c.y, 0.0))
+            && start_path(p, c, &p.start, first).is_some()
+        {
+            return Some([c.x, c.y, heading]);
+        }
+    }
+    None
 }
 
 /// One trial's outcome.
