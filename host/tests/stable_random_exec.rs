@@ -9,6 +9,7 @@ use pushbot::experiments::stable_trials::{StableTask, run_trial};
 use pushbot::planner::stable::angle_diff;
 use pushbot::planner::stable::random_scene::RandomPusher;
 use pushbot::planner::stable::robot::robot_in_slider;
+use pushbot::sim::robot::SimCamera;
 
 /// Run the random scene `seed` for `pusher` once, perturbed; the robot must start away from
 /// the first edge, and the goal be reached.
@@ -28,7 +29,7 @@ fn reaches(seed: u64, pusher: RandomPusher) {
     );
     assert!((c.x - start[0]).hypot(c.y - start[1]) > 0.1);
     let pert = task.perturbation(1, seed, true);
-    let t = run_trial(&task, seed, 1, pert, true).unwrap();
+    let t = run_trial(&task, seed, 1, pert, true, SimCamera::Truth).unwrap();
     eprintln!(
         "{}: reached {} ({:.1} mm, {:.2}°, {} re-plans, {} contact losses)",
         task.name,

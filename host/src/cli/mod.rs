@@ -27,6 +27,15 @@ pub mod strategy_args;
 mod strategy_sim;
 pub mod vision;
 
+/// `--sim-camera`: what the simulated robot sees the table with.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimCameraArg {
+    /// The simulator's poses with Gaussian noise.
+    Truth,
+    /// Rendered frames read by the host's vision pipeline.
+    Rendered,
+}
+
 /// Flags every command takes.
 #[derive(Args, Debug, Clone)]
 pub struct Global {

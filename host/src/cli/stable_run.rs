@@ -56,6 +56,12 @@ pub struct StableRunArgs {
     /// folder as `trial-N.svg`.
     #[arg(long)]
     pub svg: Option<std::path::PathBuf>,
+    /// In process (without --hil): what the simulated robot sees the table with — `truth` (the
+    /// simulator's poses with the perturbation's camera noise; the default) or `rendered`
+    /// (frames rendered from the simulated world and read by the host's detector, calibration
+    /// and tracker: the camera in the loop, in simulated time).
+    #[arg(long, value_enum)]
+    pub sim_camera: Option<super::SimCameraArg>,
 }
 
 /// `pushbot eval stable`.
@@ -79,7 +85,22 @@ pub struct StableEvalArgs {
 }
 
 impl StableRunArgs {
+    /// The in-process robot's camera.
+    #[cfg(feature = "sim")]
+    fn sim_camera(&self) -> crate::sim::robot::SimCamera {
+        match self.sim_camera {
+            Some(super::SimCameraArg::Rendered) => crate::sim::robot::SimCamera::Rendered,
+            Some(super::SimCameraArg::Truth) | None => crate::sim::robot::SimCamera::Truth,
+        }
+    }
+
     fn check(&self) -> Result<(), CliError> {
+        if self.sim_camera.is_some() && (self.hil || self.port.is_some()) {
+            return Err(CliError::bad_input(
+                "--sim-camera is the in-process robot's camera; --hil and --port use a real \
+                 camera stream",
+            ));
+        }
         if !(self.speed.is_finite() && self.speed > 0.0 && self.speed <= 50.0) {
             return Err(CliError::bad_input(format!(
                 "--sim-speed must be in (0, 50], not {}",
@@ -165,7 +186,7 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
             let robot = r.port.as_deref().zip(r.camera.as_deref());
             run_trial_live(&task, t, g.seed, pert, !r.open_loop, robot, r.speed)
         } else {
-            run_trial(&task, t, g.seed, pert, !r.open_loop)
+            run_trial(&task, t, g.seed, pert, !r.open_loop, r.sim_camera())
         };
         pb.inc(1);
         out
@@ -305,7 +326,7 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
                 Some(if r.hil {
                     run_trial_live(&task, seed, g.seed, pert, !r.open_loop, None, r.speed)?
                 } else {
-                    run_trial(&task, seed, g.seed, pert, !r.open_loop)?
+                    run_trial(&task, seed, g.seed, pert, !r.open_loop, r.sim_camera())?
                 })
             }
         };

@@ -40,16 +40,7 @@ pub struct SimArgs {
     /// markers at their heights, blur, noise — read by the host's detector, calibration and
     /// tracker: the camera in the loop). `--figure 11` defaults to `rendered`.
     #[arg(long, value_enum)]
-    pub sim_camera: Option<SimCameraArg>,
-}
-
-/// `--sim-camera`: what the simulated robot sees the table with.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SimCameraArg {
-    /// The simulator's poses with Gaussian noise.
-    Truth,
-    /// Rendered frames read by the host's vision pipeline.
-    Rendered,
+    pub sim_camera: Option<super::SimCameraArg>,
 }
 
 impl SimArgs {

@@ -7,8 +7,9 @@ use std::path::PathBuf;
 use pushbot_world::Scene;
 use serde_json::json;
 
+use super::SimCameraArg;
 use super::progress_bar;
-use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs, SimCameraArg};
+use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs};
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::experiments::delivery::collect_or_load;

@@ -24,7 +24,7 @@ use crate::planner::stable::robot::{
 };
 use crate::planner::stable::transit::point_segment_distance;
 use crate::planner::stable::{Plan, Pose, Problem, angle_diff, plan};
-use crate::sim::robot::{SimRobot, SimRobotOptions};
+use crate::sim::robot::{SimCamera, SimRobot, SimRobotOptions};
 
 /// The robot-scale versions of the presets: (name, factor on the table and every position on
 /// it, the slider's pushing edges, the contact-change cost). The slider and the robot keep
@@ -303,16 +303,20 @@ pub struct StableTrial {
 }
 
 /// Run `task` once on the in-process simulated robot, in the world `pert`, closed loop or open
-/// loop; judged by the simulator's true slider pose.
+/// loop, seeing the table through `camera` (the simulator's poses with the perturbation's camera
+/// noise, or the rendered camera read by the host's vision pipeline); judged by the simulator's
+/// true slider pose.
 pub fn run_trial(
     task: &StableTask,
     trial: u64,
     seed: u64,
     pert: Perturbation,
     closed_loop: bool,
+    camera: SimCamera,
 ) -> Result<StableTrial> {
     let scene = task.sim_scene()?;
     let opts = SimRobotOptions {
+        camera,
         seed: seed.wrapping_mul(1000).wrapping_add(trial),
         position_noise: pert.camera_xy,
         heading_noise: pert.camera_theta,
