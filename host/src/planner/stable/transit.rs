@@ -10,7 +10,7 @@
 
 use std::collections::BinaryHeap;
 
-use super::collision::{Body, Obstacle};
+use super::collision::Body;
 use super::{Pose, Problem};
 use crate::mechanics::{V2, V3, convex_hull};
 
@@ -99,21 +99,69 @@ pub fn disk_path(
     table: (f64, f64),
     obstacles: &[Vec<V2>],
 ) -> Option<Vec<V2>> {
-    let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
-    // Each obstacle's box grown by more than the octagon's circumradius.
+    let boxes: Vec<(V2, V2)> = obstacles.iter().map(|o| reach_box(o, r)).collect();
+    let mut grown = Grown {
+        fixed: &[],
+        raw: obstacles,
+        lazy: vec![None; obstacles.len()],
+        r,
+    };
+    disk_path_in(s, g, r, table, &boxes, &mut grown)
+}
+
+/// The box of `o` grown by more than the circumradius of the octagon that [`grow`] adds for a
+/// disk of radius `r`.
+fn reach_box(o: &[V2], r: f64) -> (V2, V2) {
     let reach = r / (std::f64::consts::PI / 8.0).cos() + 1e-9;
-    let boxes: Vec<(V2, V2)> = obstacles
-        .iter()
-        .map(|o| {
-            let (mut a, mut b) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
-            for p in o {
-                a = a.inf(p);
-                b = b.sup(p);
-            }
-            (a - V2::repeat(reach), b + V2::repeat(reach))
-        })
-        .collect();
-    let mut grown: Vec<Option<Vec<V2>>> = vec![None; obstacles.len()];
+    let (mut a, mut b) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+    for p in o {
+        a = a.inf(p);
+        b = b.sup(p);
+    }
+    (a - V2::repeat(reach), b + V2::repeat(reach))
+}
+
+/// The grown obstacles of one [`disk_path_in`] query: `fixed` grown beforehand (obstacles
+/// `0 .. fixed.len()`), then `raw`, grown by `r` when first needed.
+struct Grown<'a> {
+    fixed: &'a [Vec<V2>],
+    raw: &'a [Vec<V2>],
+    lazy: Vec<Option<Vec<V2>>>,
+    r: f64,
+}
+
+impl Grown<'_> {
+    /// Obstacle `i` grown (growing it now if it was not).
+    fn get(&mut self, i: usize) -> &[V2] {
+        let m = self.fixed.len();
+        if i < m {
+            return &self.fixed[i];
+        }
+        let (raw, r) = (&self.raw[i - m], self.r);
+        self.lazy[i - m].get_or_insert_with(|| grow(raw, r))
+    }
+
+    /// Obstacle `i` grown, if it was.
+    fn peek(&self, i: usize) -> Option<&[V2]> {
+        let m = self.fixed.len();
+        if i < m {
+            Some(&self.fixed[i])
+        } else {
+            self.lazy[i - m].as_deref()
+        }
+    }
+}
+
+/// [`disk_path`] among the obstacles of `grown` with their boxes `boxes` ([`reach_box`]).
+fn disk_path_in(
+    s: V2,
+    g: V2,
+    r: f64,
+    table: (f64, f64),
+    boxes: &[(V2, V2)],
+    grown: &mut Grown<'_>,
+) -> Option<Vec<V2>> {
+    let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
     let seg_box = |a: V2, b: V2, (lo, hi): (V2, V2)| {
         a.x.max(b.x) >= lo.x && a.x.min(b.x) <= hi.x && a.y.max(b.y) >= lo.y && a.y.min(b.y) <= hi.y
     };
@@ -122,23 +170,21 @@ pub fn disk_path(
             return None;
         }
         for (i, bx) in boxes.iter().enumerate() {
-            if seg_box(p, p, *bx)
-                && inside_convex(p, grown[i].get_or_insert_with(|| grow(&obstacles[i], r)))
-            {
+            if seg_box(p, p, *bx) && inside_convex(p, grown.get(i)) {
                 return None;
             }
         }
     }
     let mut subset: Vec<usize> = Vec::new();
     loop {
-        let refs: Vec<&[V2]> = subset.iter().filter_map(|&i| grown[i].as_deref()).collect();
+        let refs: Vec<&[V2]> = subset.iter().filter_map(|&i| grown.peek(i)).collect();
         let path = visibility_path(s, g, &refs, &in_table)?;
         let mut hit = Vec::new();
         for (i, bx) in boxes.iter().enumerate() {
             if subset.contains(&i) || !path.windows(2).any(|w| seg_box(w[0], w[1], *bx)) {
                 continue;
             }
-            let o = grown[i].get_or_insert_with(|| grow(&obstacles[i], r));
+            let o = grown.get(i);
             if path.windows(2).any(|w| segment_hits_convex(w[0], w[1], o)) {
                 hit.push(i);
             }
@@ -211,34 +257,135 @@ fn visibility_path(
     Some(path)
 }
 
-/// The robot's straight leg between its contact on `contact` (slider at `q`) and a stand-off
-/// point where its turning disk clears the slider. Returns the world axle-centre positions at
-/// the contact and at the stand-off, or `None` if the footprint would collide on the way.
-fn leg(p: &Problem, q: &Pose, contact: usize, r: f64) -> Option<(V2, V2)> {
-    let cm = &p.contacts[contact];
-    let pl = &cm.placement;
-    let axle_s = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
-    let back_dir = -pl.normal;
-    // Back off until the disk about the axle clears every slider vertex and edge.
-    let slider = &p.slider.vertices;
-    let clear = |c: V2| {
-        let n = slider.len();
-        (0..n).all(|i| point_segment_distance(c, slider[i], slider[(i + 1) % n]) > r + 1e-4)
-    };
-    let mut b = 0.0;
-    while !clear(axle_s + back_dir * b) {
-        b += 0.01;
-        if b > 10.0 * (r + p.slider.radius()) {
+/// The robot's straight leg off contact `contact`, in the slider frame: the axle centre at
+/// the contact, the way it backs off until the disk of radius `r` about it (the robot turning
+/// in place) clears every slider vertex and edge, and the footprint that translates so.
+#[derive(Clone)]
+struct Leg {
+    /// Axle centre at the contact (slider frame).
+    axle: V2,
+    /// Axle centre at the stand-off (slider frame).
+    stand_off: V2,
+    /// The footprint alone.
+    foot: Body,
+    /// Its translation from the contact to the stand-off (slider frame).
+    xi: V3,
+}
+
+impl Leg {
+    /// The leg off `contact` for the disk radius `r`, `None` if the robot would have to back
+    /// off implausibly far.
+    fn new(p: &Problem, contact: usize, r: f64) -> Option<Self> {
+        let cm = &p.contacts[contact];
+        let pl = &cm.placement;
+        let axle_s = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
+        let back_dir = -pl.normal;
+        // Back off until the disk about the axle clears every slider vertex and edge.
+        let slider = &p.slider.vertices;
+        let clear = |c: V2| {
+            let n = slider.len();
+            (0..n).all(|i| point_segment_distance(c, slider[i], slider[(i + 1) % n]) > r + 1e-4)
+        };
+        let mut b = 0.0;
+        while !clear(axle_s + back_dir * b) {
+            b += 0.01;
+            if b > 10.0 * (r + p.slider.radius()) {
+                return None;
+            }
+        }
+        Some(Leg {
+            axle: axle_s,
+            stand_off: axle_s + back_dir * b,
+            foot: Body::new(std::slice::from_ref(&cm.footprint)),
+            xi: V3::new(back_dir.x * b, back_dir.y * b, 0.0),
+        })
+    }
+
+    /// The world axle-centre positions at the contact and at the stand-off with the slider
+    /// at `q`, or `None` if the footprint would collide on the way (checked exactly).
+    fn at(&self, p: &Problem, q: &Pose) -> Option<(V2, V2)> {
+        if !self.foot.step_free(&p.world, q, &self.xi) {
             return None;
         }
+        Some((q.apply(self.axle), q.apply(self.stand_off)))
     }
-    // The footprint alone translates by b along −n (slider frame), checked exactly.
-    let foot = Body::new(std::slice::from_ref(&cm.footprint));
-    let xi = V3::new(back_dir.x * b, back_dir.y * b, 0.0);
-    if !foot.step_free(&p.world, q, &xi) {
-        return None;
+}
+
+/// What the transit paths of one problem share, computed once (a search asks for many): the
+/// turning disk's radius, each contact's [`Leg`], and the obstacles grown by the disk.
+#[derive(Clone)]
+pub struct Transits {
+    r: f64,
+    legs: Vec<Option<Leg>>,
+    /// The obstacles (walls excluded) grown by `r` ([`grow`]) and their boxes ([`reach_box`]).
+    grown: Vec<Vec<V2>>,
+    boxes: Vec<(V2, V2)>,
+}
+
+impl Transits {
+    /// The shared parts of problem `p`'s transit paths.
+    pub fn new(p: &Problem) -> Self {
+        if !p.pusher.is_mobile() {
+            return Transits {
+                r: 0.0,
+                legs: vec![],
+                grown: vec![],
+                boxes: vec![],
+            };
+        }
+        let r = p.pusher.turning_radius_disk();
+        let statics = &p.world.obstacles[p.world.n_walls..];
+        Transits {
+            r,
+            legs: (0..p.contacts.len()).map(|c| Leg::new(p, c, r)).collect(),
+            grown: statics.iter().map(|o| grow(&o.vertices, r)).collect(),
+            boxes: statics.iter().map(|o| reach_box(&o.vertices, r)).collect(),
+        }
     }
-    Some((q.apply(axle_s), q.apply(axle_s + back_dir * b)))
+
+    /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`
+    /// (the same as [`transit`]).
+    pub fn path(&self, p: &Problem, q: &Pose, from: usize, to: usize) -> Option<TransitPath> {
+        if !p.pusher.is_mobile() || from == to {
+            return Some(TransitPath {
+                from_contact: from,
+                to_contact: to,
+                at: *q,
+                waypoints: vec![],
+                length: 0.0,
+            });
+        }
+        let (c0, s0) = self.legs.get(from)?.as_ref()?.at(p, q)?;
+        let (c1, s1) = self.legs.get(to)?.as_ref()?.at(p, q)?;
+        let hull = [convex_hull(
+            &p.slider
+                .vertices
+                .iter()
+                .map(|v| q.apply(*v))
+                .collect::<Vec<_>>(),
+        )];
+        let mut boxes = Vec::with_capacity(self.boxes.len() + 1);
+        boxes.extend_from_slice(&self.boxes);
+        boxes.push(reach_box(&hull[0], self.r));
+        let mut grown = Grown {
+            fixed: &self.grown,
+            raw: &hull,
+            lazy: vec![None],
+            r: self.r,
+        };
+        let mid = disk_path_in(s0, s1, self.r, p.world.table, &boxes, &mut grown)?;
+        let mut pts = vec![c0];
+        pts.extend(mid);
+        pts.push(c1);
+        let length = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        Some(TransitPath {
+            from_contact: from,
+            to_contact: to,
+            at: *q,
+            waypoints: pts.iter().map(|p| [p.x, p.y]).collect(),
+            length,
+        })
+    }
 }
 
 /// Distance from point `p` to segment `a b`.
@@ -253,42 +400,9 @@ pub fn point_segment_distance(p: V2, a: V2, b: V2) -> f64 {
 }
 
 /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`.
+/// (A search asking for many builds [`Transits`] once.)
 pub fn transit(p: &Problem, q: &Pose, from: usize, to: usize, _tag: u32) -> Option<TransitPath> {
-    if !p.pusher.is_mobile() || from == to {
-        return Some(TransitPath {
-            from_contact: from,
-            to_contact: to,
-            at: *q,
-            waypoints: vec![],
-            length: 0.0,
-        });
-    }
-    let r = p.pusher.turning_radius_disk();
-    let (c0, s0) = leg(p, q, from, r)?;
-    let (c1, s1) = leg(p, q, to, r)?;
-    let mut obstacles: Vec<Vec<V2>> = p.world.obstacles[p.world.n_walls..]
-        .iter()
-        .map(|o: &Obstacle| o.vertices.clone())
-        .collect();
-    obstacles.push(convex_hull(
-        &p.slider
-            .vertices
-            .iter()
-            .map(|v| q.apply(*v))
-            .collect::<Vec<_>>(),
-    ));
-    let mid = disk_path(s0, s1, r, p.world.table, &obstacles)?;
-    let mut pts = vec![c0];
-    pts.extend(mid);
-    pts.push(c1);
-    let length = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-    Some(TransitPath {
-        from_contact: from,
-        to_contact: to,
-        at: *q,
-        waypoints: pts.iter().map(|p| [p.x, p.y]).collect(),
-        length,
-    })
+    Transits::new(p).path(p, q, from, to)
 }
 
 #[cfg(test)]

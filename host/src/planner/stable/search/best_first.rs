@@ -13,7 +13,7 @@ use super::open::{Fifo, Finish, Open, Pending, Queue};
 use super::steps::{Plan, Step, step_cost, summarise};
 use crate::planner::stable::collision::Frame;
 use crate::planner::stable::reach::unreachable;
-use crate::planner::stable::transit::{TransitPath, transit};
+use crate::planner::stable::transit::{TransitPath, Transits};
 use crate::planner::stable::{Pose, Problem, step_twist};
 
 const NONE: u32 = u32::MAX;
@@ -111,6 +111,7 @@ fn compose_sc((s, c): (f64, f64), (sd, cd): (f64, f64)) -> (f64, f64) {
 /// contact to `contact`, found once per pair (§4.6); `None` if there is none.
 fn transit_of(
     p: &Problem,
+    shared: &Transits,
     closed: &[Expanded],
     cache: &mut HashMap<(u32, u32), Option<u32>>,
     transits: &mut Vec<TransitPath>,
@@ -119,14 +120,9 @@ fn transit_of(
 ) -> Option<u32> {
     *cache.entry((parent, contact)).or_insert_with(|| {
         let par = &closed[parent as usize];
-        transit(
-            p,
-            &par.q,
-            par.contact as usize,
-            contact as usize,
-            closed.len() as u32,
-        )
-        .map(|tp| {
+        shared
+            .path(p, &par.q, par.contact as usize, contact as usize)
+            .map(|tp| {
             transits.push(tp);
             (transits.len() - 1) as u32
         })
@@ -167,6 +163,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
     let mut transits: Vec<TransitPath> = Vec::new();
     let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
+    let shared = Transits::new(p);
     let mut occupied = Grid::new(p);
     let cells = Cells::new(p);
     let max_cost = p.params.max_cost;
@@ -213,6 +210,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             if mobile && par.contact != NONE && par.contact != n.contact {
                 match transit_of(
                     p,
+                    &shared,
                     &closed,
                     &mut transit_cache,
                     &mut transits,
@@ -259,6 +257,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             if mobile && par.contact != NONE && par.contact != n.contact {
                 match transit_of(
                     p,
+                    &shared,
                     &closed,
                     &mut transit_cache,
                     &mut transits,
@@ -322,6 +321,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             if par_contact != NONE && par_contact != n.contact {
                 match transit_of(
                     p,
+                    &shared,
                     &closed,
                     &mut transit_cache,
                     &mut transits,
