@@ -10,7 +10,7 @@
 
 use std::collections::BinaryHeap;
 
-use super::collision::Body;
+use super::collision::{Body, Swept};
 use super::{Pose, Problem};
 use crate::mechanics::{V2, V3, convex_hull};
 
@@ -59,6 +59,69 @@ pub fn segment_hits_convex(p0: V2, p1: V2, poly: &[V2]) -> bool {
         }
     }
     th - tl > 1e-12
+}
+
+/// A convex polygon (counter-clockwise) ready for many [`segment_hits_convex`] tests: its
+/// edges' unit outward normals and its bounding box computed once.
+#[derive(Debug, Clone)]
+struct Hull {
+    pts: Vec<V2>,
+    outs: Vec<V2>,
+    lo: V2,
+    hi: V2,
+}
+
+impl Hull {
+    fn new(pts: Vec<V2>) -> Self {
+        let n = pts.len();
+        let outs = (0..n)
+            .map(|i| {
+                let e = pts[(i + 1) % n] - pts[i];
+                V2::new(e.y, -e.x).normalize()
+            })
+            .collect();
+        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+        for p in &pts {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        Hull { pts, outs, lo, hi }
+    }
+
+    /// [`segment_hits_convex`] for this polygon, the same arithmetic; a segment whose box
+    /// misses the polygon's misses the polygon.
+    fn hits(&self, p0: V2, p1: V2) -> bool {
+        if p0.x.max(p1.x) < self.lo.x
+            || p0.x.min(p1.x) > self.hi.x
+            || p0.y.max(p1.y) < self.lo.y
+            || p0.y.min(p1.y) > self.hi.y
+        {
+            return false;
+        }
+        let eps = 1e-9;
+        let (mut tl, mut th) = (0.0f64, 1.0f64);
+        let d = p1 - p0;
+        for (a, out) in self.pts.iter().zip(&self.outs) {
+            let num = out.dot(&(p0 - a)) + eps;
+            let den = out.dot(&d);
+            if den.abs() < 1e-15 {
+                if num > 0.0 {
+                    return false;
+                }
+            } else {
+                let t = -num / den;
+                if den > 0.0 {
+                    th = th.min(t);
+                } else {
+                    tl = tl.max(t);
+                }
+            }
+            if tl >= th {
+                return false;
+            }
+        }
+        th - tl > 1e-12
+    }
 }
 
 /// Whether `p` lies strictly inside the convex polygon `poly`.
@@ -124,30 +187,30 @@ fn reach_box(o: &[V2], r: f64) -> (V2, V2) {
 /// The grown obstacles of one [`disk_path_in`] query: `fixed` grown beforehand (obstacles
 /// `0 .. fixed.len()`), then `raw`, grown by `r` when first needed.
 struct Grown<'a> {
-    fixed: &'a [Vec<V2>],
+    fixed: &'a [Hull],
     raw: &'a [Vec<V2>],
-    lazy: Vec<Option<Vec<V2>>>,
+    lazy: Vec<Option<Hull>>,
     r: f64,
 }
 
 impl Grown<'_> {
     /// Obstacle `i` grown (growing it now if it was not).
-    fn get(&mut self, i: usize) -> &[V2] {
+    fn get(&mut self, i: usize) -> &Hull {
         let m = self.fixed.len();
         if i < m {
             return &self.fixed[i];
         }
         let (raw, r) = (&self.raw[i - m], self.r);
-        self.lazy[i - m].get_or_insert_with(|| grow(raw, r))
+        self.lazy[i - m].get_or_insert_with(|| Hull::new(grow(raw, r)))
     }
 
     /// Obstacle `i` grown, if it was.
-    fn peek(&self, i: usize) -> Option<&[V2]> {
+    fn peek(&self, i: usize) -> Option<&Hull> {
         let m = self.fixed.len();
         if i < m {
             Some(&self.fixed[i])
         } else {
-            self.lazy[i - m].as_deref()
+            self.lazy[i - m].as_ref()
         }
     }
 }
@@ -170,14 +233,14 @@ fn disk_path_in(
             return None;
         }
         for (i, bx) in boxes.iter().enumerate() {
-            if seg_box(p, p, *bx) && inside_convex(p, grown.get(i)) {
+            if seg_box(p, p, *bx) && inside_convex(p, &grown.get(i).pts) {
                 return None;
             }
         }
     }
     let mut subset: Vec<usize> = Vec::new();
     loop {
-        let refs: Vec<&[V2]> = subset.iter().filter_map(|&i| grown.peek(i)).collect();
+        let refs: Vec<&Hull> = subset.iter().filter_map(|&i| grown.peek(i)).collect();
         let path = visibility_path(s, g, &refs, &in_table)?;
         let mut hit = Vec::new();
         for (i, bx) in boxes.iter().enumerate() {
@@ -185,7 +248,7 @@ fn disk_path_in(
                 continue;
             }
             let o = grown.get(i);
-            if path.windows(2).any(|w| segment_hits_convex(w[0], w[1], o)) {
+            if path.windows(2).any(|w| o.hits(w[0], w[1])) {
                 hit.push(i);
             }
         }
@@ -199,23 +262,27 @@ fn disk_path_in(
 /// The shortest path from `s` to `g` (both free) in the visibility graph of the grown convex
 /// obstacles `grown` (their vertices pushed out by 1 µm, those inside the table and no
 /// obstacle), by A* on the straight-line distance to `g`.
+pub static TMPCOUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static TMPVIS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 fn visibility_path(
     s: V2,
     g: V2,
-    grown: &[&[V2]],
+    grown: &[&Hull],
     in_table: &dyn Fn(V2) -> bool,
 ) -> Option<Vec<V2>> {
+    TMPVIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut nodes = vec![s, g];
     for o in grown {
+        let o = &o.pts;
         let c = o.iter().sum::<V2>() / o.len() as f64;
         for v in o.iter() {
             let p = v + (v - c).normalize() * 1e-6;
-            if in_table(p) && !grown.iter().any(|q| inside_convex(p, q)) {
+            if in_table(p) && !grown.iter().any(|q| inside_convex(p, &q.pts)) {
                 nodes.push(p);
             }
         }
     }
-    let visible = |a: V2, b: V2| !grown.iter().any(|o| segment_hits_convex(a, b, o));
+    let visible = |a: V2, b: V2| !grown.iter().any(|o| o.hits(a, b));
     let n = nodes.len();
     let mut dist = vec![f64::INFINITY; n];
     let mut prev = vec![usize::MAX; n];
@@ -270,6 +337,8 @@ struct Leg {
     foot: Body,
     /// Its translation from the contact to the stand-off (slider frame).
     xi: V3,
+    /// The footprint's swept shape under `xi`.
+    swept: Swept,
 }
 
 impl Leg {
@@ -293,18 +362,25 @@ impl Leg {
                 return None;
             }
         }
+        let foot = Body::new(std::slice::from_ref(&cm.footprint));
+        let xi = V3::new(back_dir.x * b, back_dir.y * b, 0.0);
         Some(Leg {
             axle: axle_s,
             stand_off: axle_s + back_dir * b,
-            foot: Body::new(std::slice::from_ref(&cm.footprint)),
-            xi: V3::new(back_dir.x * b, back_dir.y * b, 0.0),
+            swept: foot.swept(&xi),
+            foot,
+            xi,
         })
     }
 
     /// The world axle-centre positions at the contact and at the stand-off with the slider
-    /// at `q`, or `None` if the footprint would collide on the way (checked exactly).
+    /// at `q`, or `None` if the footprint would collide on the way (checked exactly, as
+    /// [`Body::step_free`] decides, mostly by one test of the precomputed swept shape).
     fn at(&self, p: &Problem, q: &Pose) -> Option<(V2, V2)> {
-        if !self.foot.step_free(&p.world, q, &self.xi) {
+        if !self
+            .foot
+            .step_free_swept(&p.world, q, &self.xi, &self.swept)
+        {
             return None;
         }
         Some((q.apply(self.axle), q.apply(self.stand_off)))
@@ -318,7 +394,7 @@ pub struct Transits {
     r: f64,
     legs: Vec<Option<Leg>>,
     /// The obstacles (walls excluded) grown by `r` ([`grow`]) and their boxes ([`reach_box`]).
-    grown: Vec<Vec<V2>>,
+    grown: Vec<Hull>,
     boxes: Vec<(V2, V2)>,
 }
 
@@ -338,7 +414,10 @@ impl Transits {
         Transits {
             r,
             legs: (0..p.contacts.len()).map(|c| Leg::new(p, c, r)).collect(),
-            grown: statics.iter().map(|o| grow(&o.vertices, r)).collect(),
+            grown: statics
+                .iter()
+                .map(|o| Hull::new(grow(&o.vertices, r)))
+                .collect(),
             boxes: statics.iter().map(|o| reach_box(&o.vertices, r)).collect(),
         }
     }
@@ -346,6 +425,7 @@ impl Transits {
     /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`
     /// (the same as [`transit`]).
     pub fn path(&self, p: &Problem, q: &Pose, from: usize, to: usize) -> Option<TransitPath> {
+        TMPCOUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         if !p.pusher.is_mobile() || from == to {
             return Some(TransitPath {
                 from_contact: from,
