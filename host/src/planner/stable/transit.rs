@@ -284,15 +284,12 @@ fn disk_path_in(
 /// The shortest path from `s` to `g` (both free) in the visibility graph of the grown convex
 /// obstacles `grown` (their vertices pushed out by 1 µm, those inside the table and no
 /// obstacle), by A* on the straight-line distance to `g`.
-pub static TMPCOUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static TMPVIS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 fn visibility_path(
     s: V2,
     g: V2,
     grown: &[&Hull],
     in_table: &dyn Fn(V2) -> bool,
 ) -> Option<Vec<V2>> {
-    TMPVIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut nodes = vec![s, g];
     for o in grown {
         let o = &o.pts;
@@ -456,7 +453,6 @@ impl Transits {
     /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`
     /// (the same as [`transit`]).
     pub fn path(&self, p: &Problem, q: &Pose, from: usize, to: usize) -> Option<TransitPath> {
-        TMPCOUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         if !p.pusher.is_mobile() || from == to {
             return Some(TransitPath {
                 from_contact: from,

@@ -127,9 +127,9 @@ fn transit_of(
         shared
             .path(p, &par.q, par.contact as usize, contact as usize)
             .map(|tp| {
-            transits.push(tp);
-            (transits.len() - 1) as u32
-        })
+                transits.push(tp);
+                (transits.len() - 1) as u32
+            })
     })
 }
 
