@@ -7,6 +7,12 @@
 //! slider, each grown by the disk's radius (Minkowski sum with a circumscribed octagon, so the
 //! growth is conservative), and drives straight onto the new edge. The two straight legs are
 //! checked with the exact footprint.
+//!
+//! The slider's octagon turns with the slider (its hull is grown once, in the slider frame), so
+//! whether a contact's stand-off point lies outside it does not depend on the slider's heading:
+//! with a world-aligned octagon a corner of it covered the stand-off point off an edge at some
+//! headings and the transit was refused there (and with it many car plans). [`Transits`] holds
+//! what a search's many transit paths share.
 
 use std::collections::BinaryHeap;
 
@@ -72,6 +78,22 @@ struct Hull {
 }
 
 impl Hull {
+    /// This polygon (slider frame) placed at `q`: its points and normals turned with it.
+    fn placed(&self, q: &Pose) -> Hull {
+        let pts: Vec<V2> = self.pts.iter().map(|p| q.apply(*p)).collect();
+        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+        for p in &pts {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        Hull {
+            pts,
+            outs: self.outs.iter().map(|n| q.rotate(*n)).collect(),
+            lo,
+            hi,
+        }
+    }
+
     fn new(pts: Vec<V2>) -> Self {
         let n = pts.len();
         let outs = (0..n)
@@ -200,8 +222,8 @@ impl Grown<'_> {
         if i < m {
             return &self.fixed[i];
         }
-        let (raw, r) = (&self.raw[i - m], self.r);
-        self.lazy[i - m].get_or_insert_with(|| Hull::new(grow(raw, r)))
+        let (raw, r) = (self.raw, self.r);
+        self.lazy[i - m].get_or_insert_with(|| Hull::new(grow(&raw[i - m], r)))
     }
 
     /// Obstacle `i` grown, if it was.
@@ -393,6 +415,10 @@ pub struct Transits {
     /// The obstacles (walls excluded) grown by `r` ([`grow`]) and their boxes ([`reach_box`]).
     grown: Vec<Hull>,
     boxes: Vec<(V2, V2)>,
+    /// The slider's convex hull and that hull grown by `r`, slider frame (the octagon turns
+    /// with the slider: it still holds the disk about every point of the hull).
+    slider_hull: Vec<V2>,
+    slider_grown: Hull,
 }
 
 impl Transits {
@@ -404,10 +430,13 @@ impl Transits {
                 legs: vec![],
                 grown: vec![],
                 boxes: vec![],
+                slider_hull: vec![],
+                slider_grown: Hull::new(vec![]),
             };
         }
         let r = p.pusher.turning_radius_disk();
         let statics = &p.world.obstacles[p.world.n_walls..];
+        let slider_grown = Hull::new(grow(&p.slider.vertices, r));
         Transits {
             r,
             legs: (0..p.contacts.len()).map(|c| Leg::new(p, c, r)).collect(),
@@ -416,6 +445,8 @@ impl Transits {
                 .map(|o| Hull::new(grow(&o.vertices, r)))
                 .collect(),
             boxes: statics.iter().map(|o| reach_box(&o.vertices, r)).collect(),
+            slider_hull: convex_hull(&p.slider.vertices),
+            slider_grown,
         }
     }
 
@@ -433,20 +464,14 @@ impl Transits {
         }
         let (c0, s0) = self.legs.get(from)?.as_ref()?.at(p, q)?;
         let (c1, s1) = self.legs.get(to)?.as_ref()?.at(p, q)?;
-        let hull = [convex_hull(
-            &p.slider
-                .vertices
-                .iter()
-                .map(|v| q.apply(*v))
-                .collect::<Vec<_>>(),
-        )];
+        let hull: Vec<V2> = self.slider_hull.iter().map(|v| q.apply(*v)).collect();
         let mut boxes = Vec::with_capacity(self.boxes.len() + 1);
         boxes.extend_from_slice(&self.boxes);
-        boxes.push(reach_box(&hull[0], self.r));
+        boxes.push(reach_box(&hull, self.r));
         let mut grown = Grown {
             fixed: &self.grown,
-            raw: &hull,
-            lazy: vec![None],
+            raw: &[],
+            lazy: vec![Some(self.slider_grown.placed(q))],
             r: self.r,
         };
         let mid = disk_path_in(s0, s1, self.r, p.world.table, &boxes, &mut grown)?;
