@@ -7,10 +7,16 @@
 //! slider, each grown by the disk's radius (Minkowski sum with a circumscribed octagon, so the
 //! growth is conservative), and drives straight onto the new edge. The two straight legs are
 //! checked with the exact footprint.
+//!
+//! The slider's octagon turns with the slider (its hull is grown once, in the slider frame), so
+//! whether a contact's stand-off point lies outside it does not depend on the slider's heading:
+//! with a world-aligned octagon a corner of it covered the stand-off point off an edge at some
+//! headings and the transit was refused there (and with it many car plans). [`Transits`] holds
+//! what a search's many transit paths share.
 
 use std::collections::BinaryHeap;
 
-use super::collision::{Body, Obstacle};
+use super::collision::{Body, Swept};
 use super::{Pose, Problem};
 use crate::mechanics::{V2, V3, convex_hull};
 
@@ -61,6 +67,85 @@ pub fn segment_hits_convex(p0: V2, p1: V2, poly: &[V2]) -> bool {
     th - tl > 1e-12
 }
 
+/// A convex polygon (counter-clockwise) ready for many [`segment_hits_convex`] tests: its
+/// edges' unit outward normals and its bounding box computed once.
+#[derive(Debug, Clone)]
+struct Hull {
+    pts: Vec<V2>,
+    outs: Vec<V2>,
+    lo: V2,
+    hi: V2,
+}
+
+impl Hull {
+    /// This polygon (slider frame) placed at `q`: its points and normals turned with it.
+    fn placed(&self, q: &Pose) -> Hull {
+        let pts: Vec<V2> = self.pts.iter().map(|p| q.apply(*p)).collect();
+        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+        for p in &pts {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        Hull {
+            pts,
+            outs: self.outs.iter().map(|n| q.rotate(*n)).collect(),
+            lo,
+            hi,
+        }
+    }
+
+    fn new(pts: Vec<V2>) -> Self {
+        let n = pts.len();
+        let outs = (0..n)
+            .map(|i| {
+                let e = pts[(i + 1) % n] - pts[i];
+                V2::new(e.y, -e.x).normalize()
+            })
+            .collect();
+        let (mut lo, mut hi) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+        for p in &pts {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        Hull { pts, outs, lo, hi }
+    }
+
+    /// [`segment_hits_convex`] for this polygon, the same arithmetic; a segment whose box
+    /// misses the polygon's misses the polygon.
+    fn hits(&self, p0: V2, p1: V2) -> bool {
+        if p0.x.max(p1.x) < self.lo.x
+            || p0.x.min(p1.x) > self.hi.x
+            || p0.y.max(p1.y) < self.lo.y
+            || p0.y.min(p1.y) > self.hi.y
+        {
+            return false;
+        }
+        let eps = 1e-9;
+        let (mut tl, mut th) = (0.0f64, 1.0f64);
+        let d = p1 - p0;
+        for (a, out) in self.pts.iter().zip(&self.outs) {
+            let num = out.dot(&(p0 - a)) + eps;
+            let den = out.dot(&d);
+            if den.abs() < 1e-15 {
+                if num > 0.0 {
+                    return false;
+                }
+            } else {
+                let t = -num / den;
+                if den > 0.0 {
+                    th = th.min(t);
+                } else {
+                    tl = tl.max(t);
+                }
+            }
+            if tl >= th {
+                return false;
+            }
+        }
+        th - tl > 1e-12
+    }
+}
+
 /// Whether `p` lies strictly inside the convex polygon `poly`.
 fn inside_convex(p: V2, poly: &[V2]) -> bool {
     let n = poly.len();
@@ -99,21 +184,69 @@ pub fn disk_path(
     table: (f64, f64),
     obstacles: &[Vec<V2>],
 ) -> Option<Vec<V2>> {
-    let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
-    // Each obstacle's box grown by more than the octagon's circumradius.
+    let boxes: Vec<(V2, V2)> = obstacles.iter().map(|o| reach_box(o, r)).collect();
+    let mut grown = Grown {
+        fixed: &[],
+        raw: obstacles,
+        lazy: vec![None; obstacles.len()],
+        r,
+    };
+    disk_path_in(s, g, r, table, &boxes, &mut grown)
+}
+
+/// The box of `o` grown by more than the circumradius of the octagon that [`grow`] adds for a
+/// disk of radius `r`.
+fn reach_box(o: &[V2], r: f64) -> (V2, V2) {
     let reach = r / (std::f64::consts::PI / 8.0).cos() + 1e-9;
-    let boxes: Vec<(V2, V2)> = obstacles
-        .iter()
-        .map(|o| {
-            let (mut a, mut b) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
-            for p in o {
-                a = a.inf(p);
-                b = b.sup(p);
-            }
-            (a - V2::repeat(reach), b + V2::repeat(reach))
-        })
-        .collect();
-    let mut grown: Vec<Option<Vec<V2>>> = vec![None; obstacles.len()];
+    let (mut a, mut b) = (V2::repeat(f64::INFINITY), V2::repeat(f64::NEG_INFINITY));
+    for p in o {
+        a = a.inf(p);
+        b = b.sup(p);
+    }
+    (a - V2::repeat(reach), b + V2::repeat(reach))
+}
+
+/// The grown obstacles of one [`disk_path_in`] query: `fixed` grown beforehand (obstacles
+/// `0 .. fixed.len()`), then `raw`, grown by `r` when first needed.
+struct Grown<'a> {
+    fixed: &'a [Hull],
+    raw: &'a [Vec<V2>],
+    lazy: Vec<Option<Hull>>,
+    r: f64,
+}
+
+impl Grown<'_> {
+    /// Obstacle `i` grown (growing it now if it was not).
+    fn get(&mut self, i: usize) -> &Hull {
+        let m = self.fixed.len();
+        if i < m {
+            return &self.fixed[i];
+        }
+        let (raw, r) = (self.raw, self.r);
+        self.lazy[i - m].get_or_insert_with(|| Hull::new(grow(&raw[i - m], r)))
+    }
+
+    /// Obstacle `i` grown, if it was.
+    fn peek(&self, i: usize) -> Option<&Hull> {
+        let m = self.fixed.len();
+        if i < m {
+            Some(&self.fixed[i])
+        } else {
+            self.lazy[i - m].as_ref()
+        }
+    }
+}
+
+/// [`disk_path`] among the obstacles of `grown` with their boxes `boxes` ([`reach_box`]).
+fn disk_path_in(
+    s: V2,
+    g: V2,
+    r: f64,
+    table: (f64, f64),
+    boxes: &[(V2, V2)],
+    grown: &mut Grown<'_>,
+) -> Option<Vec<V2>> {
+    let in_table = |p: V2| p.x >= r && p.x <= table.0 - r && p.y >= r && p.y <= table.1 - r;
     let seg_box = |a: V2, b: V2, (lo, hi): (V2, V2)| {
         a.x.max(b.x) >= lo.x && a.x.min(b.x) <= hi.x && a.y.max(b.y) >= lo.y && a.y.min(b.y) <= hi.y
     };
@@ -122,24 +255,22 @@ pub fn disk_path(
             return None;
         }
         for (i, bx) in boxes.iter().enumerate() {
-            if seg_box(p, p, *bx)
-                && inside_convex(p, grown[i].get_or_insert_with(|| grow(&obstacles[i], r)))
-            {
+            if seg_box(p, p, *bx) && inside_convex(p, &grown.get(i).pts) {
                 return None;
             }
         }
     }
     let mut subset: Vec<usize> = Vec::new();
     loop {
-        let refs: Vec<&[V2]> = subset.iter().filter_map(|&i| grown[i].as_deref()).collect();
+        let refs: Vec<&Hull> = subset.iter().filter_map(|&i| grown.peek(i)).collect();
         let path = visibility_path(s, g, &refs, &in_table)?;
         let mut hit = Vec::new();
         for (i, bx) in boxes.iter().enumerate() {
             if subset.contains(&i) || !path.windows(2).any(|w| seg_box(w[0], w[1], *bx)) {
                 continue;
             }
-            let o = grown[i].get_or_insert_with(|| grow(&obstacles[i], r));
-            if path.windows(2).any(|w| segment_hits_convex(w[0], w[1], o)) {
+            let o = grown.get(i);
+            if path.windows(2).any(|w| o.hits(w[0], w[1])) {
                 hit.push(i);
             }
         }
@@ -156,20 +287,21 @@ pub fn disk_path(
 fn visibility_path(
     s: V2,
     g: V2,
-    grown: &[&[V2]],
+    grown: &[&Hull],
     in_table: &dyn Fn(V2) -> bool,
 ) -> Option<Vec<V2>> {
     let mut nodes = vec![s, g];
     for o in grown {
+        let o = &o.pts;
         let c = o.iter().sum::<V2>() / o.len() as f64;
         for v in o.iter() {
             let p = v + (v - c).normalize() * 1e-6;
-            if in_table(p) && !grown.iter().any(|q| inside_convex(p, q)) {
+            if in_table(p) && !grown.iter().any(|q| inside_convex(p, &q.pts)) {
                 nodes.push(p);
             }
         }
     }
-    let visible = |a: V2, b: V2| !grown.iter().any(|o| segment_hits_convex(a, b, o));
+    let visible = |a: V2, b: V2| !grown.iter().any(|o| o.hits(a, b));
     let n = nodes.len();
     let mut dist = vec![f64::INFINITY; n];
     let mut prev = vec![usize::MAX; n];
@@ -211,34 +343,150 @@ fn visibility_path(
     Some(path)
 }
 
-/// The robot's straight leg between its contact on `contact` (slider at `q`) and a stand-off
-/// point where its turning disk clears the slider. Returns the world axle-centre positions at
-/// the contact and at the stand-off, or `None` if the footprint would collide on the way.
-fn leg(p: &Problem, q: &Pose, contact: usize, r: f64) -> Option<(V2, V2)> {
-    let cm = &p.contacts[contact];
-    let pl = &cm.placement;
-    let axle_s = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
-    let back_dir = -pl.normal;
-    // Back off until the disk about the axle clears every slider vertex and edge.
-    let slider = &p.slider.vertices;
-    let clear = |c: V2| {
-        let n = slider.len();
-        (0..n).all(|i| point_segment_distance(c, slider[i], slider[(i + 1) % n]) > r + 1e-4)
-    };
-    let mut b = 0.0;
-    while !clear(axle_s + back_dir * b) {
-        b += 0.01;
-        if b > 10.0 * (r + p.slider.radius()) {
+/// The robot's straight leg off contact `contact`, in the slider frame: the axle centre at
+/// the contact, the way it backs off until the disk of radius `r` about it (the robot turning
+/// in place) clears every slider vertex and edge, and the footprint that translates so.
+#[derive(Clone)]
+struct Leg {
+    /// Axle centre at the contact (slider frame).
+    axle: V2,
+    /// Axle centre at the stand-off (slider frame).
+    stand_off: V2,
+    /// The footprint alone.
+    foot: Body,
+    /// Its translation from the contact to the stand-off (slider frame).
+    xi: V3,
+    /// The footprint's swept shape under `xi`.
+    swept: Swept,
+}
+
+impl Leg {
+    /// The leg off `contact` for the disk radius `r`, `None` if the robot would have to back
+    /// off implausibly far.
+    fn new(p: &Problem, contact: usize, r: f64) -> Option<Self> {
+        let cm = &p.contacts[contact];
+        let pl = &cm.placement;
+        let axle_s = pl.to_slider(V2::new(0.0, -p.pusher.axle_offset));
+        let back_dir = -pl.normal;
+        // Back off until the disk about the axle clears every slider vertex and edge.
+        let slider = &p.slider.vertices;
+        let clear = |c: V2| {
+            let n = slider.len();
+            (0..n).all(|i| point_segment_distance(c, slider[i], slider[(i + 1) % n]) > r + 1e-4)
+        };
+        let mut b = 0.0;
+        while !clear(axle_s + back_dir * b) {
+            b += 0.01;
+            if b > 10.0 * (r + p.slider.radius()) {
+                return None;
+            }
+        }
+        let foot = Body::new(std::slice::from_ref(&cm.footprint));
+        let xi = V3::new(back_dir.x * b, back_dir.y * b, 0.0);
+        Some(Leg {
+            axle: axle_s,
+            stand_off: axle_s + back_dir * b,
+            swept: foot.swept(&xi),
+            foot,
+            xi,
+        })
+    }
+
+    /// The world axle-centre positions at the contact and at the stand-off with the slider
+    /// at `q`, or `None` if the footprint would collide on the way (checked exactly, as
+    /// [`Body::step_free`] decides, mostly by one test of the precomputed swept shape).
+    fn at(&self, p: &Problem, q: &Pose) -> Option<(V2, V2)> {
+        if !self
+            .foot
+            .step_free_swept(&p.world, q, &self.xi, &self.swept)
+        {
             return None;
         }
+        Some((q.apply(self.axle), q.apply(self.stand_off)))
     }
-    // The footprint alone translates by b along −n (slider frame), checked exactly.
-    let foot = Body::new(std::slice::from_ref(&cm.footprint));
-    let xi = V3::new(back_dir.x * b, back_dir.y * b, 0.0);
-    if !foot.step_free(&p.world, q, &xi) {
-        return None;
+}
+
+/// What the transit paths of one problem share, computed once (a search asks for many): the
+/// turning disk's radius, each contact's [`Leg`], and the obstacles grown by the disk.
+#[derive(Clone)]
+pub struct Transits {
+    r: f64,
+    legs: Vec<Option<Leg>>,
+    /// The obstacles (walls excluded) grown by `r` ([`grow`]) and their boxes ([`reach_box`]).
+    grown: Vec<Hull>,
+    boxes: Vec<(V2, V2)>,
+    /// The slider's convex hull and that hull grown by `r`, slider frame (the octagon turns
+    /// with the slider: it still holds the disk about every point of the hull).
+    slider_hull: Vec<V2>,
+    slider_grown: Hull,
+}
+
+impl Transits {
+    /// The shared parts of problem `p`'s transit paths.
+    pub fn new(p: &Problem) -> Self {
+        if !p.pusher.is_mobile() {
+            return Transits {
+                r: 0.0,
+                legs: vec![],
+                grown: vec![],
+                boxes: vec![],
+                slider_hull: vec![],
+                slider_grown: Hull::new(vec![]),
+            };
+        }
+        let r = p.pusher.turning_radius_disk();
+        let statics = &p.world.obstacles[p.world.n_walls..];
+        let slider_grown = Hull::new(grow(&p.slider.vertices, r));
+        Transits {
+            r,
+            legs: (0..p.contacts.len()).map(|c| Leg::new(p, c, r)).collect(),
+            grown: statics
+                .iter()
+                .map(|o| Hull::new(grow(&o.vertices, r)))
+                .collect(),
+            boxes: statics.iter().map(|o| reach_box(&o.vertices, r)).collect(),
+            slider_hull: convex_hull(&p.slider.vertices),
+            slider_grown,
+        }
     }
-    Some((q.apply(axle_s), q.apply(axle_s + back_dir * b)))
+
+    /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`
+    /// (the same as [`transit`]).
+    pub fn path(&self, p: &Problem, q: &Pose, from: usize, to: usize) -> Option<TransitPath> {
+        if !p.pusher.is_mobile() || from == to {
+            return Some(TransitPath {
+                from_contact: from,
+                to_contact: to,
+                at: *q,
+                waypoints: vec![],
+                length: 0.0,
+            });
+        }
+        let (c0, s0) = self.legs.get(from)?.as_ref()?.at(p, q)?;
+        let (c1, s1) = self.legs.get(to)?.as_ref()?.at(p, q)?;
+        let hull: Vec<V2> = self.slider_hull.iter().map(|v| q.apply(*v)).collect();
+        let mut boxes = Vec::with_capacity(self.boxes.len() + 1);
+        boxes.extend_from_slice(&self.boxes);
+        boxes.push(reach_box(&hull, self.r));
+        let mut grown = Grown {
+            fixed: &self.grown,
+            raw: &[],
+            lazy: vec![Some(self.slider_grown.placed(q))],
+            r: self.r,
+        };
+        let mid = disk_path_in(s0, s1, self.r, p.world.table, &boxes, &mut grown)?;
+        let mut pts = vec![c0];
+        pts.extend(mid);
+        pts.push(c1);
+        let length = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        Some(TransitPath {
+            from_contact: from,
+            to_contact: to,
+            at: *q,
+            waypoints: pts.iter().map(|p| [p.x, p.y]).collect(),
+            length,
+        })
+    }
 }
 
 /// Distance from point `p` to segment `a b`.
@@ -253,42 +501,9 @@ pub fn point_segment_distance(p: V2, a: V2, b: V2) -> f64 {
 }
 
 /// A transit path from contact `from` to contact `to` with the slider at `q`, or `None`.
+/// (A search asking for many builds [`Transits`] once.)
 pub fn transit(p: &Problem, q: &Pose, from: usize, to: usize, _tag: u32) -> Option<TransitPath> {
-    if !p.pusher.is_mobile() || from == to {
-        return Some(TransitPath {
-            from_contact: from,
-            to_contact: to,
-            at: *q,
-            waypoints: vec![],
-            length: 0.0,
-        });
-    }
-    let r = p.pusher.turning_radius_disk();
-    let (c0, s0) = leg(p, q, from, r)?;
-    let (c1, s1) = leg(p, q, to, r)?;
-    let mut obstacles: Vec<Vec<V2>> = p.world.obstacles[p.world.n_walls..]
-        .iter()
-        .map(|o: &Obstacle| o.vertices.clone())
-        .collect();
-    obstacles.push(convex_hull(
-        &p.slider
-            .vertices
-            .iter()
-            .map(|v| q.apply(*v))
-            .collect::<Vec<_>>(),
-    ));
-    let mid = disk_path(s0, s1, r, p.world.table, &obstacles)?;
-    let mut pts = vec![c0];
-    pts.extend(mid);
-    pts.push(c1);
-    let length = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-    Some(TransitPath {
-        from_contact: from,
-        to_contact: to,
-        at: *q,
-        waypoints: pts.iter().map(|p| [p.x, p.y]).collect(),
-        length,
-    })
+    Transits::new(p).path(p, q, from, to)
 }
 
 #[cfg(test)]

@@ -3,20 +3,24 @@
 //! node limit, and expand it with every contact's controls; then read the plan back.
 
 use std::collections::{BinaryHeap, HashMap};
+use std::hash::BuildHasherDefault;
 use std::time::Instant;
 
 use super::bound::Heuristic;
 use super::crossing::goal_finish;
 use super::finish::pushes_in_steps;
-use super::grid::{Cells, Grid};
+use super::grid::{Cells, Grid, GridHasher};
 use super::open::{Fifo, Finish, Open, Pending, Queue};
 use super::steps::{Plan, Step, step_cost, summarise};
 use crate::planner::stable::collision::Frame;
 use crate::planner::stable::reach::unreachable;
-use crate::planner::stable::transit::{TransitPath, transit};
+use crate::planner::stable::transit::{TransitPath, Transits};
 use crate::planner::stable::{Pose, Problem, step_twist};
 
 const NONE: u32 = u32::MAX;
+
+/// The transit found (index into the plan's transits) or not for each (expanded node, contact).
+type TransitCache = HashMap<(u32, u32), Option<u32>, BuildHasherDefault<GridHasher>>;
 
 /// When a generated step's collision is checked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -111,25 +115,21 @@ fn compose_sc((s, c): (f64, f64), (sd, cd): (f64, f64)) -> (f64, f64) {
 /// contact to `contact`, found once per pair (§4.6); `None` if there is none.
 fn transit_of(
     p: &Problem,
+    shared: &Transits,
     closed: &[Expanded],
-    cache: &mut HashMap<(u32, u32), Option<u32>>,
+    cache: &mut TransitCache,
     transits: &mut Vec<TransitPath>,
     parent: u32,
     contact: u32,
 ) -> Option<u32> {
     *cache.entry((parent, contact)).or_insert_with(|| {
         let par = &closed[parent as usize];
-        transit(
-            p,
-            &par.q,
-            par.contact as usize,
-            contact as usize,
-            closed.len() as u32,
-        )
-        .map(|tp| {
-            transits.push(tp);
-            (transits.len() - 1) as u32
-        })
+        shared
+            .path(p, &par.q, par.contact as usize, contact as usize)
+            .map(|tp| {
+                transits.push(tp);
+                (transits.len() - 1) as u32
+            })
     })
 }
 
@@ -166,7 +166,8 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
     let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
     let mut transits: Vec<TransitPath> = Vec::new();
-    let mut transit_cache: HashMap<(u32, u32), Option<u32>> = HashMap::new();
+    let mut transit_cache = TransitCache::default();
+    let shared = Transits::new(p);
     let mut occupied = Grid::new(p);
     let cells = Cells::new(p);
     let max_cost = p.params.max_cost;
@@ -213,6 +214,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             if mobile && par.contact != NONE && par.contact != n.contact {
                 match transit_of(
                     p,
+                    &shared,
                     &closed,
                     &mut transit_cache,
                     &mut transits,
@@ -259,6 +261,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             if mobile && par.contact != NONE && par.contact != n.contact {
                 match transit_of(
                     p,
+                    &shared,
                     &closed,
                     &mut transit_cache,
                     &mut transits,
@@ -322,6 +325,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             if par_contact != NONE && par_contact != n.contact {
                 match transit_of(
                     p,
+                    &shared,
                     &closed,
                     &mut transit_cache,
                     &mut transits,

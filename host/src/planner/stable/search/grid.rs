@@ -8,9 +8,9 @@ use std::hash::{BuildHasherDefault, Hasher};
 use crate::planner::stable::{Pose, Problem, wrap_2pi};
 
 /// A small multiplicative hasher for the pruning grid's integer keys (SipHash is the search's
-/// bottleneck otherwise).
+/// bottleneck otherwise), and the search's other integer-keyed maps.
 #[derive(Default)]
-struct GridHasher(u64);
+pub(super) struct GridHasher(u64);
 
 impl Hasher for GridHasher {
     fn finish(&self) -> u64 {
