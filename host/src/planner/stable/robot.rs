@@ -139,6 +139,23 @@ pub fn robot_start(p: &Problem, plan: &Plan) -> Option<[f64; 3]> {
     Some([a0.x, a0.y, h0.y.atan2(h0.x)])
 }
 
+/// Least scale of the overhead camera's image, pixels per metre: a 5 cm marker is then 19 px
+/// wide, which the detector reads through blur and noise.
+pub const MIN_PX_PER_M: f64 = 380.0;
+
+/// The overhead camera's image size for `table` (m) when the default 960 × 720 (16 px borders)
+/// would show it at less than [`MIN_PX_PER_M`]: the default scaled up, to a multiple of 16.
+pub fn camera_image(table: [f64; 2]) -> Option<[u32; 2]> {
+    let (w, h) = (960.0, 720.0);
+    let scale = ((w - 32.0) / table[0]).min((h - 32.0) / table[1]);
+    if !(scale.is_finite() && scale > 0.0) || scale >= MIN_PX_PER_M {
+        return None;
+    }
+    let k = MIN_PX_PER_M / scale;
+    let up = |v: f64| ((v * k / 16.0).ceil() * 16.0) as u32;
+    Some([up(w), up(h)])
+}
+
 /// The simulated scene of the problem: the same table and obstacles, the slider (object frame
 /// at its centre of friction, marker `marker_id` on it), the robot with its plate at `start`.
 pub fn sim_scene(
@@ -151,6 +168,11 @@ pub fn sim_scene(
         "name = \"{}\"\n[table]\nwidth = {}\nheight = {}\n[robot]\nstart = {{ x = {}, y = {}, theta = {} }}\nfront_plate = {{ width = {PLATE_WIDTH}, offset = {PLATE_OFFSET} }}\n",
         s.name, s.table[0], s.table[1], start[0], start[1], start[2]
     );
+    // The overhead camera sees the whole table; on a large table (a scaled preset) its image
+    // grows so the markers keep the scale they have on a small one.
+    if let Some([w, h]) = camera_image(s.table) {
+        t += &format!("[camera]\nwidth = {w}\nheight = {h}\n");
+    }
     for o in &s.obstacles {
         t += &format!("[[obstacles]]\noutline = {:?}\n", o.polygon);
     }
@@ -208,4 +230,28 @@ pub fn arcs(p: &Problem, plan: &Plan) -> Vec<PushArc> {
         }
     }
     runs.into_iter().map(|(_, a)| a).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The presets' own tables keep the default image; the scaled Fig. 13 (3.6 × 2.4 m) gets
+    /// one that shows it at the least scale, and no larger than it needs.
+    #[test]
+    fn large_tables_get_a_larger_image_at_the_least_scale() {
+        assert_eq!(camera_image([1.6, 1.2]), None);
+        assert_eq!(
+            camera_image([2.4, 1.6]),
+            None,
+            "Fig. 17 × 2 is seen at 387 px/m"
+        );
+        let [w, h] = camera_image([3.6, 2.4]).unwrap();
+        let scale = ((f64::from(w) - 32.0) / 3.6).min((f64::from(h) - 32.0) / 2.4);
+        assert!(
+            (MIN_PX_PER_M..MIN_PX_PER_M + 10.0).contains(&scale),
+            "{w} × {h}: {scale}"
+        );
+        assert!(w % 16 == 0 && h % 16 == 0);
+    }
 }
