@@ -124,12 +124,7 @@ fn run_hil(global: &Global, a: &DeliveryArgs, scene: &Scene) -> CliResult {
                 .samples
         }
         (Method::Learned, None) => {
-            let params = a.active.apply(CollectParams {
-                initial: a.initial,
-                streak: a.streak,
-                seed: global.seed,
-                ..CollectParams::default()
-            })?;
+            let params = a.collect_params(global.seed)?;
             // With --strategy-dir every sample is written as it is collected: a collection cut
             // short (a link that did not come back, a person stopping it) keeps what it had, and
             // the next run goes on from there.

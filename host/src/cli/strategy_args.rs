@@ -290,6 +290,17 @@ pub enum BenchCmd {
 }
 
 impl DeliveryArgs {
+    /// The collection's parameters these arguments set (K, streak, the active collection's
+    /// options), seeded by `seed`.
+    pub fn collect_params(&self, seed: u64) -> Result<CollectParams, CliError> {
+        self.active.apply(CollectParams {
+            initial: self.initial,
+            streak: self.streak,
+            seed,
+            ..CollectParams::default()
+        })
+    }
+
     /// The delivery parameters these arguments set (time limit, boundary guard).
     pub fn delivery_params(&self) -> Result<DeliveryParams, CliError> {
         let d = DeliveryParams::default();

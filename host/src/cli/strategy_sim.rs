@@ -185,12 +185,7 @@ fn strategy_for(
     setup: &TrialSetup,
     quiet: bool,
 ) -> Result<(Vec<Sample>, Option<CollectReport>), CliError> {
-    let params = a.active.apply(CollectParams {
-        initial: a.initial,
-        streak: a.streak,
-        seed: global.seed,
-        ..CollectParams::default()
-    })?;
+    let params = a.collect_params(global.seed)?;
     if let Some(path) = &a.strategy {
         let samples = store::load(path)
             .map_err(|e| CliError::bad_input(e.to_string()))?

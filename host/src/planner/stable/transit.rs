@@ -38,14 +38,25 @@ pub struct TransitPath {
 /// Whether segment `p0 → p1` passes through the interior of the convex polygon `poly`
 /// (counter-clockwise), by Cyrus–Beck clipping.
 pub fn segment_hits_convex(p0: V2, p1: V2, poly: &[V2]) -> bool {
+    let n = poly.len();
+    clips(
+        p0,
+        p1,
+        (0..n).map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            let e = b - a;
+            (a, V2::new(e.y, -e.x).normalize())
+        }),
+    )
+}
+
+/// Cyrus–Beck: whether segment `p0 → p1` keeps a piece of positive length inside every edge
+/// given as (a point on it, its outward unit normal).
+fn clips(p0: V2, p1: V2, edges: impl Iterator<Item = (V2, V2)>) -> bool {
     let eps = 1e-9;
     let (mut tl, mut th) = (0.0f64, 1.0f64);
     let d = p1 - p0;
-    let n = poly.len();
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        let e = b - a;
-        let out = V2::new(e.y, -e.x).normalize();
+    for (a, out) in edges {
         let num = out.dot(&(p0 - a)) + eps;
         let den = out.dot(&d);
         if den.abs() < 1e-15 {
@@ -120,29 +131,11 @@ impl Hull {
         {
             return false;
         }
-        let eps = 1e-9;
-        let (mut tl, mut th) = (0.0f64, 1.0f64);
-        let d = p1 - p0;
-        for (a, out) in self.pts.iter().zip(&self.outs) {
-            let num = out.dot(&(p0 - a)) + eps;
-            let den = out.dot(&d);
-            if den.abs() < 1e-15 {
-                if num > 0.0 {
-                    return false;
-                }
-            } else {
-                let t = -num / den;
-                if den > 0.0 {
-                    th = th.min(t);
-                } else {
-                    tl = tl.max(t);
-                }
-            }
-            if tl >= th {
-                return false;
-            }
-        }
-        th - tl > 1e-12
+        clips(
+            p0,
+            p1,
+            self.pts.iter().copied().zip(self.outs.iter().copied()),
+        )
     }
 }
 
