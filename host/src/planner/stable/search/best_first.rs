@@ -112,7 +112,9 @@ fn compose_sc((s, c): (f64, f64), (sd, cd): (f64, f64)) -> (f64, f64) {
 }
 
 /// The transit path (index into `transits`) of a mobile pusher from expanded node `parent`'s
-/// contact to `contact`, found once per pair (§4.6); `None` if there is none.
+/// contact to `contact`, found once per pair (§4.6); `None` if there is none. The search needs
+/// only whether one exists ([`Transits::any_path`]); the plan's own are made shortest when it
+/// is read off ([`shortest`]).
 fn transit_of(
     p: &Problem,
     shared: &Transits,
@@ -125,12 +127,20 @@ fn transit_of(
     *cache.entry((parent, contact)).or_insert_with(|| {
         let par = &closed[parent as usize];
         shared
-            .path(p, &par.q, par.contact as usize, contact as usize)
+            .any_path(p, &par.q, par.contact as usize, contact as usize)
             .map(|tp| {
                 transits.push(tp);
                 (transits.len() - 1) as u32
             })
     })
+}
+
+/// A shortest transit path in place of `t` (found by [`Transits::any_path`]), which stands if
+/// none is found (there is one: the two agree on existence).
+fn shortest(p: &Problem, shared: &Transits, t: &TransitPath) -> TransitPath {
+    shared
+        .path(p, &t.at, t.from_contact, t.to_contact)
+        .unwrap_or_else(|| t.clone())
 }
 
 /// Plan with the given OPEN list.
@@ -521,7 +531,8 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                     heur.steps(&par.q) as usize,
                 ));
                 if n.transit != NONE {
-                    plan.transits.push(transits[n.transit as usize].clone());
+                    plan.transits
+                        .push(shortest(p, &shared, &transits[n.transit as usize]));
                 }
                 continue;
             }
@@ -535,7 +546,8 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 twist: [xi.x, xi.y, xi.z],
             });
             if n.transit != NONE {
-                plan.transits.push(transits[n.transit as usize].clone());
+                plan.transits
+                    .push(shortest(p, &shared, &transits[n.transit as usize]));
             }
         }
         plan.found = true;
