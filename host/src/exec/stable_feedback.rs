@@ -38,6 +38,13 @@ use crate::planner::stable::robot::{SPEED, robot_in_slider};
 use crate::planner::stable::transit::transit;
 use crate::planner::stable::{Plan, Pose, Problem, angle_diff};
 
+/// After the plate lost the edge, the pusher–slider friction the loop plans with is cut by
+/// this factor …
+const MU_CUT: f64 = 0.8;
+
+/// … down to this share of the nominal one.
+const MIN_MU_SHARE: f64 = 0.5;
+
 /// Settings of the closed loop.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FeedbackParams {
@@ -254,6 +261,13 @@ fn track(
         let (side, gap) = (cross(h, rel), -rel.dot(&h));
         let dth = angle_diff(r.theta, h.y.atan2(h.x));
         if gap.abs() > fp.lost_xy || side.abs() > fp.lost_xy || dth.abs() > fp.lost_theta {
+            tracing::info!(
+                "stable closed loop: the plate is off the edge: gap {:.1} mm, sideways {:.1} mm, \
+                 turned {:.1}°",
+                gap * 1e3,
+                side * 1e3,
+                dth.to_degrees()
+            );
             return Ok(Tracked::Lost);
         }
         if last && well_in_goal(p, &s) {
@@ -391,13 +405,15 @@ pub fn execute_closed_loop(
         return Ok(run);
     }
     let mut contact = first;
+    // The model the loop plans and steers with: the nominal one until the plate slides.
+    let mut model = p.clone();
     // Bounds of the current plan: widened once when no plan exists from the measured pose and
     // the current one is followed on.
     let mut relax = 1.0;
     // The segment to go on from, and the one being driven.
     let (mut first_seg, mut at_seg) = (0, 0);
     loop {
-        let segs = segments(p, &current);
+        let segs = segments(&model, &current);
         let mut outcome = Tracked::Done;
         let mut transits = current.transits.iter().peekable();
         let mut fpr = *fp;
@@ -415,7 +431,7 @@ pub fn execute_closed_loop(
                     Some(t) => t,
                     None => {
                         let (_, s) = observe(io)?;
-                        match transit(p, &s, contact, seg.contact, 0) {
+                        match transit(&model, &s, contact, seg.contact, 0) {
                             Some(t) => t,
                             None => {
                                 outcome = Tracked::NoTransit;
@@ -424,11 +440,11 @@ pub fn execute_closed_loop(
                         }
                     }
                 };
-                drive_transit(p, &tr, io)
+                drive_transit(&model, &tr, io)
                     .with_context(|| format!("transit {contact} → {}", seg.contact))?;
                 contact = seg.contact;
             }
-            outcome = track(p, seg, io, &fpr, &mut run, k + 1 == segs.len())?;
+            outcome = track(&model, seg, io, &fpr, &mut run, k + 1 == segs.len())?;
             if outcome != Tracked::Done {
                 break;
             }
@@ -439,7 +455,21 @@ pub fn execute_closed_loop(
                 run.failure = Some(format!("lost the edge {} times", run.contact_losses));
                 break;
             }
-            reacquire(p, contact, io)?;
+            // The slider slid on the plate: the friction between them is lower than the model's
+            // (a wrong guess is one of the errors the loop is for). Plan and steer from now on
+            // with less of it, so that the stable sets, and the turns they allow, are narrower.
+            if model.mu > MIN_MU_SHARE * p.mu
+                && let Some(m) = model.with_mu((model.mu * MU_CUT).max(MIN_MU_SHARE * p.mu))
+            {
+                tracing::info!(
+                    "stable closed loop: the edge was lost: planning with pusher friction {:.3} \
+                     (was {:.3})",
+                    m.mu,
+                    model.mu
+                );
+                model = m;
+            }
+            reacquire(&model, contact, io)?;
         }
         let (_, s) = observe(io)?;
         run.end = s;
@@ -464,7 +494,7 @@ pub fn execute_closed_loop(
             }
             break;
         }
-        let next = replan(p, s, contact, &mut run);
+        let next = replan(&model, s, contact, &mut run);
         tracing::info!(
             "stable closed loop: re-plan {}: {:?}",
             run.replans,

@@ -223,6 +223,31 @@ pub struct Problem {
 }
 
 impl Problem {
+    /// The same problem with pusher–slider friction `mu`: STABLE run again on every contact's
+    /// edge (labels and start contact kept); `None` when an edge then has no usable push.
+    pub fn with_mu(&self, mu: f64) -> Option<Problem> {
+        let edges: Vec<usize> = self.contacts.iter().map(|c| c.edge).collect();
+        let mut q = Problem::new(
+            self.world.clone(),
+            self.slider.clone(),
+            mu,
+            self.pusher.clone(),
+            &edges,
+            self.start,
+            self.goal,
+            self.params.clone(),
+        )
+        .ok()?;
+        if q.contacts.iter().any(|c| c.usable.controls.is_empty()) {
+            return None;
+        }
+        for (a, b) in q.contacts.iter_mut().zip(&self.contacts) {
+            a.label = b.label;
+        }
+        q.start_contact = self.start_contact;
+        Some(q)
+    }
+
     /// Build a problem: run STABLE on each listed edge, intersect with the pusher's feasible
     /// pushes, scale the extremal directions to one step.
     #[allow(clippy::too_many_arguments)]
@@ -364,6 +389,49 @@ pub fn step_twist(slider: &Slider, v: &V3, step: f64) -> V3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn less_friction_narrows_every_contacts_turns() {
+        // The closed loop re-plans with less pusher friction after the plate slid: STABLE run
+        // again must give each contact turns no tighter than before, tighter somewhere
+        // narrower, and keep the contacts' labels and order.
+        let tightest = |p: &Problem| -> Vec<f64> {
+            p.contacts
+                .iter()
+                .map(|c| {
+                    c.usable
+                        .controls
+                        .iter()
+                        .map(|v| v.z.abs() / v.x.hypot(v.y).max(1e-12))
+                        .fold(0.0, f64::max)
+                })
+                .collect()
+        };
+        let mut narrower = 0;
+        for seed in 1..=5 {
+            let p = random_scene::random_scene(seed, random_scene::RandomPusher::DiffDrive)
+                .unwrap()
+                .problem()
+                .unwrap();
+            let q = p
+                .with_mu(p.mu * 0.6)
+                .expect("usable pushes with less friction");
+            assert_eq!(q.mu, p.mu * 0.6);
+            let labels = |p: &Problem| {
+                p.contacts
+                    .iter()
+                    .map(|c| (c.edge, c.label))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(labels(&q), labels(&p));
+            assert_eq!(q.start_contact, p.start_contact);
+            for (a, b) in tightest(&q).into_iter().zip(tightest(&p)) {
+                assert!(a <= b + 1e-9, "tighter with less friction: {a} > {b}");
+                narrower += usize::from(a < b - 1e-6);
+            }
+        }
+        assert!(narrower > 0);
+    }
 
     #[test]
     fn integrate_and_twist_to_round_trip() {

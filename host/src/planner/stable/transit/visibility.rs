@@ -259,14 +259,11 @@ pub(super) fn path_among(
     let n_fixed = graph.nodes.len();
     let visible = |u: usize, v: usize| {
         let (a, b) = (nodes[u], nodes[v]);
-        if extra.hits(a, b) {
-            return false;
-        }
         if u >= base && v >= base {
             let (i, j) = (fixed[u - base], fixed[v - base]);
-            graph.sees[i * n_fixed + j]
+            graph.sees[i * n_fixed + j] && !extra.hits(a, b)
         } else {
-            !grown.iter().any(|o| o.hits(a, b))
+            !extra.hits(a, b) && !grown.iter().any(|o| o.hits(a, b))
         }
     };
     shortest_in(&nodes, visible)
