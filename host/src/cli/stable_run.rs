@@ -235,18 +235,7 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
         );
         println!("trial  reached  error mm   error °  re-plans  contact losses");
         for t in &rows {
-            println!(
-                "{:5}  {:7}  {:8.1}  {:8.2}  {:8}  {:14}{}",
-                t.trial,
-                if t.reached { "yes" } else { "NO" },
-                t.final_error_m * 1e3,
-                t.final_error_deg,
-                t.replans,
-                t.contact_losses,
-                t.failure
-                    .as_ref()
-                    .map_or(String::new(), |f| format!("  ({f})"))
-            );
+            println!("{:5}  {}", t.trial, trial_row(t));
         }
         println!(
             "reached {reached} of {n}; mean final error {:.1} mm; mean re-plans {:.1}",
@@ -382,17 +371,7 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
         for (s, t) in &rows {
             match t {
                 None => println!("{s:5}  none"),
-                Some(t) => println!(
-                    "{s:5}  yes   {:7}  {:8.1}  {:8.2}  {:8}  {:14}{}",
-                    if t.reached { "yes" } else { "NO" },
-                    t.final_error_m * 1e3,
-                    t.final_error_deg,
-                    t.replans,
-                    t.contact_losses,
-                    t.failure
-                        .as_ref()
-                        .map_or(String::new(), |f| format!("  ({f})"))
-                ),
+                Some(t) => println!("{s:5}  yes   {}", trial_row(t)),
             }
         }
         println!(
@@ -410,4 +389,20 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
 fn eval_random(_g: &Global, a: &StableEvalArgs, _n: u64) -> CliResult {
     a.run.check()?;
     Err(super::no_simulated_target())
+}
+
+/// One trial's row of the text tables: reached, final error (mm, °), re-plans, contact losses
+/// and the failure, if any.
+fn trial_row(t: &crate::experiments::stable_trials::StableTrial) -> String {
+    format!(
+        "{:7}  {:8.1}  {:8.2}  {:8}  {:14}{}",
+        if t.reached { "yes" } else { "NO" },
+        t.final_error_m * 1e3,
+        t.final_error_deg,
+        t.replans,
+        t.contact_losses,
+        t.failure
+            .as_ref()
+            .map_or(String::new(), |f| format!("  ({f})"))
+    )
 }

@@ -243,19 +243,12 @@ pub(super) fn path_among(
     let mut nodes = vec![s, g];
     nodes.extend(nudged(extra).filter(|&p| in_region(p, region) && !blocked(p)));
     let base = nodes.len();
-    // Fixed nodes inside the extra obstacle are left out: they map to no index.
-    let mut index = Vec::with_capacity(graph.nodes.len());
-    for &p in &graph.nodes {
-        if inside_convex(p, &extra.pts) {
-            index.push(usize::MAX);
-        } else {
-            index.push(nodes.len());
-            nodes.push(p);
-        }
-    }
+    // The fixed nodes outside the extra obstacle follow, `fixed[k]` being the graph's index of
+    // node `base + k`.
     let fixed: Vec<usize> = (0..graph.nodes.len())
-        .filter(|&i| index[i] != usize::MAX)
+        .filter(|&i| !inside_convex(graph.nodes[i], &extra.pts))
         .collect();
+    nodes.extend(fixed.iter().map(|&i| graph.nodes[i]));
     let n_fixed = graph.nodes.len();
     let visible = |u: usize, v: usize| {
         let (a, b) = (nodes[u], nodes[v]);
@@ -272,8 +265,7 @@ pub(super) fn path_among(
 /// The ways from `s` to `g` around the one convex polygon `hull`, shortest first, as way
 /// points through its vertices (each pushed out by 1 µm, as [`visibility_path`] does): the
 /// straight segment when it misses the polygon, else the shortest way on each side of the
-/// line from `s` to `g`. None
-/// when `s` or `g` lies inside it.
+/// line from `s` to `g`. None when `s` or `g` lies inside it.
 pub(super) fn ways_around(hull: &Hull, s: V2, g: V2) -> Vec<Vec<V2>> {
     let pts = &hull.pts;
     if inside_convex(s, pts) || inside_convex(g, pts) {
