@@ -393,6 +393,7 @@ fn eval_random(_g: &Global, a: &StableEvalArgs, _n: u64) -> CliResult {
 
 /// One trial's row of the text tables: reached, final error (mm, °), re-plans, contact losses
 /// and the failure, if any.
+#[cfg(feature = "sim")]
 fn trial_row(t: &crate::experiments::stable_trials::StableTrial) -> String {
     format!(
         "{:7}  {:8.1}  {:8.2}  {:8}  {:14}{}",
