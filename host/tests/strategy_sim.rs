@@ -162,7 +162,9 @@ fn delivery_adds_supplemental_samples_at_once() {
 #[test]
 fn collect_once_then_deliver_around_a_wall_from_the_cache() {
     use pushbot::experiments::delivery::{collect_and_deliver, collect_or_load};
-    use pushbot::planner::global::{ObstacleParams, clearance, scene_obstacles};
+    use pushbot::planner::global::{
+        ObstacleParams, clearance, path_length, scene_obstacles, shortest_object_path,
+    };
     let dir = tempfile::tempdir().unwrap();
     let cache = dir.path().join("irregular.strategy");
     let scene = Scene::preset("lau-obstacles").unwrap();
@@ -231,7 +233,20 @@ fn collect_once_then_deliver_around_a_wall_from_the_cache() {
         .find(|o| (0.78..=0.88).contains(&o.x))
         .expect("the object passed the wall's x");
     assert!(crossing.y < 0.55, "crossed at {crossing:?}");
-    assert!(out.result.subgoals.len() >= 3, "{:?}", out.result.subgoals);
+    // Following the path's moving sub-goal, the object's path is within 1.3× the shortest
+    // collision-free path of its bounding circle (issue 24), measured on the camera's track.
+    let shortest = shortest_object_path(
+        &SimRobot::new(scene.clone(), None, None, sim)
+            .unwrap()
+            .workspace(),
+        &wall,
+        start,
+        goal,
+        &ObstacleParams::default(),
+    )
+    .expect("a shortest path");
+    let ratio = d.object_path / path_length(&shortest);
+    assert!((1.0..1.3).contains(&ratio), "path ratio {ratio}");
 }
 
 /// The live layout (`pushbot eval delivery --hil`): the robot cannot leave the table, and the

@@ -1,15 +1,15 @@
 //! Delivery among obstacles (Lau, Mitani & Igarashi §III-E, last paragraph): the global path
-//! ([`crate::planner::global`]) re-planned from the object's observed position before each leg,
-//! and Algorithm 2 ([`crate::strategy::deliver::deliver_learned_among`]) pushing to the path's
-//! point `subgoal_spacing` ahead (a sub-goal, reached within `subgoal_radius`), until the last
-//! leg reaches the goal within the success radius.
+//! ([`crate::planner::global`]) planned from the object's observed position, and Algorithm 2
+//! ([`crate::exec::deliver::deliver_learned_among`]) pushing the object towards the path's
+//! moving sub-goal, `lookahead` further along the path than the object
+//! ([`crate::planner::path_follow`]), until it reaches the goal within the success radius.
 //!
-//! A leg that makes no progress towards its sub-goal for `stall_time` (the object caught on a
-//! corner, the path looping) is a **stall**, never a silent time-out: the robot backs off the
-//! object, the path is planned again from the object's measured pose, and the sub-goals come
-//! closer together (halved at each stall in a row); from the second stall in a row the object
-//! is first pushed a little from a side the robot can reach. Each recovery is recorded
-//! ([`Recovery`]); after `max_recoveries` the delivery fails as stalled.
+//! A leg that makes no progress along its path for `stall_time` (the object caught on a
+//! corner) is a **stall**, never a silent time-out: the robot backs off the object, the path is
+//! planned again from the object's measured pose, and the look-ahead shortens (halved at each
+//! stall in a row); from the second stall in a row the object is first pushed a little from a
+//! side the robot can reach. Each recovery is recorded ([`Recovery`]); after `max_recoveries`
+//! the delivery fails as stalled.
 
 use anyhow::Result;
 use nalgebra::Vector2;
@@ -17,9 +17,8 @@ use nalgebra::Vector2;
 use crate::exec::deliver::{Delivery, DeliveryParams, Failure, Recovery, deliver_learned_among};
 use crate::exec::io::RobotIo;
 use crate::exec::io::Workspace;
-use crate::planner::global::{
-    ObstacleParams, clearance, path_length, plan_object_path, point_along, robot_fits,
-};
+use crate::planner::global::{ObstacleParams, clearance, plan_object_path, robot_fits};
+use crate::planner::path_follow::PathFollower;
 use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::Sample;
 
@@ -28,7 +27,8 @@ use crate::strategy::sample::Sample;
 pub struct ObstacleDelivery {
     /// The whole delivery (time, steps and trajectory over all legs).
     pub delivery: Delivery,
-    /// The sub-goals pushed to, in order (the last is the goal when reached).
+    /// Where the moving sub-goal was when each leg ended (a leg ends at the goal, a stall or
+    /// a failure; one leg per planned path).
     pub subgoals: Vec<[f64; 2]>,
     /// The first global path planned.
     pub path: Vec<[f64; 2]>,
@@ -62,9 +62,9 @@ pub fn deliver_among_obstacles(
     };
     let mut subgoals = Vec::new();
     let mut first_path = Vec::new();
-    let mut legs = 0;
-    // Sub-goal spacing: halved at each stall in a row, back to the default after progress.
-    let mut spacing = op.subgoal_spacing;
+    // Look-ahead of the moving sub-goal: halved at each stall in a row (the object is then
+    // kept closer to the path), back to the default after progress.
+    let mut lookahead = op.lookahead;
     let mut stalls_in_a_row = 0;
     loop {
         let o = io.object_pose().position();
@@ -78,35 +78,31 @@ pub fn deliver_among_obstacles(
         if first_path.is_empty() {
             first_path = shown;
         }
-        let length = path_length(&path);
-        let last = length <= spacing * 1.5;
-        let sub = if last {
-            goal
-        } else {
-            point_along(&path, spacing).unwrap_or(goal)
+        let Some(mut follow) = PathFollower::new(&path, lookahead) else {
+            all.failure = Some(Failure::NoPath);
+            break;
         };
-        subgoals.push([sub.x, sub.y]);
-        let leg_params = if last {
-            DeliveryParams {
-                time_limit: left,
-                stall_time: op.stall_time,
-                ..*params
-            }
-        } else {
-            DeliveryParams {
-                time_limit: left,
-                success_radius: op.subgoal_radius,
-                fine_radius: op.subgoal_radius,
-                stall_time: op.stall_time,
-                ..*params
-            }
+        let leg_params = DeliveryParams {
+            time_limit: left,
+            stall_time: op.stall_time,
+            reposition_angle: op.reposition_angle,
+            ..*params
         };
-        legs += 1;
-        let d = deliver_learned_among(io, strategy, sub, &leg_params, obstacles, sink)?;
+        let d = deliver_learned_among(
+            io,
+            strategy,
+            goal,
+            &leg_params,
+            obstacles,
+            Some(&mut follow),
+            sink,
+        )?;
         let failure = d.failure;
         add_leg(&mut all, d);
+        let o = io.object_pose().position();
+        let sub = follow.aim(o).subgoal;
+        subgoals.push([sub.x, sub.y]);
         if failure == Some(Failure::Stalled) {
-            let o = io.object_pose().position();
             if all.recoveries.len() >= op.max_recoveries {
                 tracing::warn!(
                     "delivery stalled at ({:.3}, {:.3}) after {} recoveries: giving up",
@@ -118,8 +114,7 @@ pub fn deliver_among_obstacles(
                 break;
             }
             stalls_in_a_row += 1;
-            spacing =
-                (op.subgoal_spacing / 2f64.powi(stalls_in_a_row)).max(1.5 * op.subgoal_radius);
+            lookahead = (op.lookahead / 2f64.powi(stalls_in_a_row)).max(op.subgoal_radius);
             // A second stall in a row: the robot cannot get behind the object for the way the
             // path wants; push it a little from a side it can reach, then plan again.
             let aside = (stalls_in_a_row > 1)
@@ -127,10 +122,10 @@ pub fn deliver_among_obstacles(
                 .flatten();
             let action = match aside {
                 Some(t) => format!(
-                    "back off, push to ({:.3}, {:.3}) from a side the robot can reach, re-plan, sub-goals every {spacing:.3} m",
+                    "back off, push to ({:.3}, {:.3}) from a side the robot can reach, re-plan, look-ahead {lookahead:.3} m",
                     t.x, t.y
                 ),
-                None => format!("back off and re-plan, sub-goals every {spacing:.3} m"),
+                None => format!("back off and re-plan, look-ahead {lookahead:.3} m"),
             };
             tracing::info!(
                 "delivery stalled at ({:.3}, {:.3}) pushing to ({:.3}, {:.3}): {action}",
@@ -155,25 +150,14 @@ pub fn deliver_among_obstacles(
                     stall_time: op.stall_time / 2.0,
                     ..*params
                 };
-                let d = deliver_learned_among(io, strategy, t, &side, obstacles, sink)?;
+                let d = deliver_learned_among(io, strategy, t, &side, obstacles, None, sink)?;
                 add_leg(&mut all, d);
             }
             continue;
         }
-        if failure.is_some() {
-            all.failure = failure;
-            break;
-        }
-        spacing = op.subgoal_spacing;
-        stalls_in_a_row = 0;
-        if last {
-            all.success = true;
-            break;
-        }
-        if legs > 200 {
-            all.failure = Some(Failure::TimeLimit);
-            break;
-        }
+        all.failure = failure;
+        all.success = failure.is_none();
+        break;
     }
     all.time = io.time() - start;
     all.final_distance = (goal - io.object_pose().position()).norm();

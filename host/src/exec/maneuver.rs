@@ -9,7 +9,7 @@
 use anyhow::Result;
 use nalgebra::Vector2;
 
-use crate::exec::io::RobotIo;
+use crate::exec::io::{RobotIo, Workspace};
 use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
 use crate::strategy::sample::{Pose2, wrap_angle};
 
@@ -215,28 +215,68 @@ pub fn circle_walk(
     } else {
         r.theta + std::f64::consts::PI
     };
+    let around = around_object(&ws, obstacles, centre, radius);
+    if !obstacles.is_empty() && circle_cut(&ws, obstacles, &on, from, to, rel.norm() < radius) {
+        // An obstacle cuts the circle both ways (a corridor, a wall's end) or stands where the
+        // robot would join it: go to the stand point by a path around the obstacles and the
+        // object instead.
+        if rel.norm() < radius {
+            face(io, angle_of(-rel), &Turn::two_level(tol))?;
+            let back = clamp(on(from)) - io.robot_pose().position();
+            io.forward(-back.norm())?;
+        }
+        return transit(io, on(to), &around, &Drive::two_level(tol));
+    }
     if rel.norm() < radius {
         // Back straight away from the centre onto the circle.
         face(io, angle_of(-rel), &Turn::two_level(tol))?;
         let back = clamp(on(from)) - io.robot_pose().position();
         io.forward(-back.norm())?;
     } else {
-        // From afar, around the obstacles and the object itself (a disc inside the circle).
-        let mut around = obstacles.to_vec();
-        let inner = radius - ws.robot_radius - 0.015;
-        if inner > 0.0 && !obstacles.is_empty() {
-            around.push(
-                (0..12)
-                    .map(|k| {
-                        let a = k as f64 * std::f64::consts::TAU / 12.0;
-                        let p = centre + inner * Vector2::new(a.cos(), a.sin());
-                        [p.x, p.y]
-                    })
-                    .collect(),
-            );
-        }
+        // From afar, around the obstacles and the object itself.
         transit(io, clamp(on(from)), &around, &Drive::two_level(tol))?;
     }
+    let (a, b) = circle_routes(from, to);
+    let blocked = |pts: &[f64]| {
+        pts.iter()
+            .filter(|a| !robot_fits(&ws, obstacles, on(**a)))
+            .count()
+    };
+    let pts = if blocked(&a) <= blocked(&b) { a } else { b };
+    for ang in pts {
+        go_to(io, clamp(on(ang)), &Drive::two_level(tol))?;
+    }
+    Ok(())
+}
+
+/// `obstacles` and, when there are any, the object inside the bound-all circle of `radius`
+/// about `centre` as one more (a 12-gon the robot on the circle clears): what a path to a
+/// stand point on the circle must go round.
+pub fn around_object(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    centre: Vector2<f64>,
+    radius: f64,
+) -> Vec<Vec<[f64; 2]>> {
+    let mut around = obstacles.to_vec();
+    let inner = radius - ws.robot_radius - 0.015;
+    if inner > 0.0 && !obstacles.is_empty() {
+        around.push(
+            (0..12)
+                .map(|k| {
+                    let a = k as f64 * std::f64::consts::TAU / 12.0;
+                    let p = centre + inner * Vector2::new(a.cos(), a.sin());
+                    [p.x, p.y]
+                })
+                .collect(),
+        );
+    }
+    around
+}
+
+/// The two ways along the circle from angle `from` to `to`, as the angles of chords of at most
+/// 30°, the short way first.
+fn circle_routes(from: f64, to: f64) -> (Vec<f64>, Vec<f64>) {
     let delta = wrap_angle(to - from);
     let other = if delta >= 0.0 {
         delta - std::f64::consts::TAU
@@ -247,15 +287,74 @@ pub fn circle_walk(
         let n = (d.abs() / 30f64.to_radians()).ceil().max(1.0) as usize;
         (1..=n).map(|i| from + d * i as f64 / n as f64).collect()
     };
-    let blocked = |pts: &[f64]| {
-        pts.iter()
-            .filter(|a| !robot_fits(&ws, obstacles, on(**a)))
-            .count()
-    };
-    let (a, b) = (route(delta), route(other));
-    let pts = if blocked(&a) <= blocked(&b) { a } else { b };
-    for ang in pts {
-        go_to(io, clamp(on(ang)), &Drive::two_level(tol))?;
+    (route(delta), route(other))
+}
+
+/// Whether the walk round the circle (`on`) from angle `from` to `to` is cut: the stand point
+/// is clear but every way along the circle to it (each chord end checked), or the point where
+/// a robot from outside (`inside` false) joins it, is not.
+fn circle_cut(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    on: &dyn Fn(f64) -> Vector2<f64>,
+    from: f64,
+    to: f64,
+    inside: bool,
+) -> bool {
+    if !robot_fits(ws, obstacles, on(to)) {
+        return false;
     }
-    Ok(())
+    let clear = |pts: &[f64]| pts.iter().all(|a| robot_fits(ws, obstacles, on(*a)));
+    let (a, b) = circle_routes(from, to);
+    let joins = inside || robot_fits(ws, obstacles, on(from));
+    !joins || !(clear(&a) || clear(&b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exec::io::Rect;
+
+    fn ws() -> Workspace {
+        Workspace {
+            table: Rect {
+                min: [-0.25, -0.25],
+                max: [1.85, 1.45],
+            },
+            boundary: Rect {
+                min: [0.1, 0.1],
+                max: [1.5, 1.1],
+            },
+            robot_radius: 0.04,
+            object_radius: 0.075,
+        }
+    }
+
+    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+        vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+    }
+
+    /// In a 0.3 m corridor the bound-all circle (radius 0.155 m) runs into both walls: from
+    /// above the object to below it neither way round is open, and a robot from outside cannot
+    /// join the circle inside a wall. On the open table nothing is cut, and a stand point in a
+    /// wall is not for the circle walk to decide.
+    #[test]
+    fn a_corridor_cuts_the_circle_both_ways() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let ws = ws();
+        let walls = vec![rect(0.6, 0.0, 0.7, 1.2), rect(1.0, 0.0, 1.1, 1.2)];
+        let c = Vector2::new(0.85, 0.5);
+        let on = |a: f64| c + 0.155 * Vector2::new(a.cos(), a.sin());
+        assert!(circle_cut(&ws, &walls, &on, FRAC_PI_2, -FRAC_PI_2, true));
+        // Joining from outside at the left, inside the wall.
+        assert!(circle_cut(&ws, &walls, &on, PI, FRAC_PI_2, false));
+        // Above to a little to its right: the short way is open.
+        assert!(!circle_cut(&ws, &walls, &on, FRAC_PI_2, 1.2, true));
+        // The open table.
+        assert!(!circle_cut(&ws, &[], &on, FRAC_PI_2, -FRAC_PI_2, true));
+        let far = vec![rect(1.3, 0.0, 1.4, 0.2)];
+        assert!(!circle_cut(&ws, &far, &on, PI, 0.0, false));
+        // A stand point inside the wall.
+        assert!(!circle_cut(&ws, &walls, &on, FRAC_PI_2, PI, true));
+    }
 }

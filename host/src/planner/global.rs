@@ -36,10 +36,15 @@ pub struct ObstacleParams {
     pub room_penalty: u32,
     /// Cost factor of moves without room for the robot behind the object (1: not checked).
     pub behind_penalty: u32,
-    /// Distance along the path to the next sub-goal, m.
-    pub subgoal_spacing: f64,
-    /// A sub-goal (not the goal) counts as reached within this distance, m.
+    /// How far along the path beyond the object its moving sub-goal is, m
+    /// ([`crate::planner::path_follow`]).
+    pub lookahead: f64,
+    /// A recovery's push aside counts as done within this distance, m; the shortest
+    /// look-ahead.
     pub subgoal_radius: f64,
+    /// A push that moves the object off the way to its sub-goal by more than this is followed
+    /// by a re-positioning, rad ([`crate::exec::deliver::DeliveryParams::reposition_angle`]).
+    pub reposition_angle: f64,
     /// A leg stalls when the object comes no closer to its sub-goal for this long, s.
     pub stall_time: f64,
     /// Recoveries tried before a delivery is given up as stalled.
@@ -54,8 +59,9 @@ impl Default for ObstacleParams {
             room_margin: 0.02,
             room_penalty: 4,
             behind_penalty: 8,
-            subgoal_spacing: 0.15,
+            lookahead: 0.12,
             subgoal_radius: 0.04,
+            reposition_angle: 30f64.to_radians(),
             stall_time: 60.0,
             max_recoveries: 4,
         }
@@ -172,10 +178,22 @@ pub fn plan_object_path(
             || d.try_normalize(1e-12)
                 .is_none_or(|u| robot_fits(ws, obstacles, x - u * behind))
     };
-    let (s0, g) = (cell_of(start), cell_of(goal));
-    if at(g) == 0 {
-        return None;
+    let (s0, g0) = (cell_of(start), cell_of(goal));
+    // A goal on the clearance's edge may round to a blocked cell: the nearest free cell within
+    // two cells stands in for it (the path still ends at the goal itself).
+    let mut g = None;
+    for dj in -2..=2i32 {
+        for di in -2..=2i32 {
+            let n = (g0.0 + di, g0.1 + dj);
+            if n.0 < 0 || n.1 < 0 || n.0 >= nx || n.1 >= ny || at(n) == 0 {
+                continue;
+            }
+            if g.is_none_or(|(_, d)| di * di + dj * dj < d) {
+                g = Some((n, di * di + dj * dj));
+            }
+        }
     }
+    let g = g?.0;
     // An object pushed closer to an obstacle than its clearance (it is there, so it fits) leaves
     // by the nearest free cell within ESCAPE of it, straight away from what it is close to.
     let s = if at(s0) > 0 {
@@ -243,19 +261,6 @@ pub fn plan_object_path(
         *last = goal;
     }
     Some(path)
-}
-
-/// The point `spacing` along `path` from its start (its end when shorter).
-pub fn point_along(path: &[Vector2<f64>], spacing: f64) -> Option<Vector2<f64>> {
-    let mut left = spacing;
-    for w in path.windows(2) {
-        let seg = (w[1] - w[0]).norm();
-        if seg >= left && seg > 0.0 {
-            return Some(w[0] + (w[1] - w[0]) * (left / seg));
-        }
-        left -= seg;
-    }
-    path.last().copied()
 }
 
 /// Whether the robot's centre may stand at `p`: on the table and clear of every obstacle (by
@@ -447,7 +452,7 @@ mod tests {
     }
 
     #[test]
-    fn no_path_through_a_closed_wall_and_point_along_walks_the_path() {
+    fn no_path_through_a_closed_wall() {
         let ws = ws();
         let p = ObstacleParams::default();
         let wall = vec![rect(0.78, 0.0, 0.88, 1.2)];
@@ -461,14 +466,6 @@ mod tests {
             )
             .is_none()
         );
-        let path = vec![
-            Vector2::new(0.0, 0.0),
-            Vector2::new(1.0, 0.0),
-            Vector2::new(1.0, 1.0),
-        ];
-        assert_eq!(point_along(&path, 0.5), Some(Vector2::new(0.5, 0.0)));
-        assert_eq!(point_along(&path, 1.5), Some(Vector2::new(1.0, 0.5)));
-        assert_eq!(point_along(&path, 5.0), Some(Vector2::new(1.0, 1.0)));
     }
 
     /// An object left against the wall's face (closer than its clearance): the path leaves
