@@ -384,7 +384,7 @@ fn stage_strategy(ctx: &mut Ctx<'_>, scene: &Scene) -> Result<StageReport> {
     st.mission_s = d.time;
     st.number("steps", d.steps);
     st.number("repositions", d.repositions);
-    st.number("subgoals", res.subgoals.len());
+    st.number("legs", res.subgoals.len());
     st.number("final_distance_m (camera)", d.final_distance);
     if let Some(last) = trace.last().and_then(|p| p.truth.clone()) {
         let m = scene_marker_truth(&object, &last.1);
