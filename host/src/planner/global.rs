@@ -530,6 +530,43 @@ mod tests {
     /// string past the wall's end (at the object's clearance), shorter than the grid's path
     /// and than the delivery's path (which pays for the robot's room), and no shorter than the
     /// two straight legs through the corner it bends at.
+    /// Stand points where the robot only just fits (beside an object's disc, as the special
+    /// case asks for them) all get a path from across a wall, ending there: a goal on the
+    /// clearance's edge that rounds to a blocked grid cell is stood in for by a free one. Before,
+    /// some had none, and the robot drove straight into the wall.
+    #[test]
+    fn a_goal_on_the_clearance_edge_still_has_a_path() {
+        let ws = ws();
+        let wall = rect(0.78, 0.55, 0.88, 1.2);
+        let centre = Vector2::new(1.3, 0.95);
+        // The object, a 12-gon; its robot-clearance edge at 0.055 m (radius + 1.5 cm).
+        let inner = 0.1;
+        let disc: Vec<[f64; 2]> = (0..12)
+            .map(|k| {
+                let a = f64::from(k) * std::f64::consts::TAU / 12.0;
+                [centre.x + inner * a.cos(), centre.y + inner * a.sin()]
+            })
+            .collect();
+        let around = vec![wall, disc];
+        let from = Vector2::new(0.5, 0.8);
+        let mut planned = 0;
+        for k in 0..48 {
+            let a = f64::from(k) * std::f64::consts::TAU / 48.0;
+            let target = centre + (inner + 0.055) * Vector2::new(a.cos(), a.sin());
+            if !robot_fits(&ws, &around, target) {
+                continue;
+            }
+            let path = plan_robot_path(&ws, &around, from, target)
+                .unwrap_or_else(|| panic!("no path to {target:?}"));
+            assert_eq!(*path.last().unwrap(), target);
+            for w in path.windows(2) {
+                assert!(segment_clear(&ws, &around[..1], w[0], w[1]), "{w:?}");
+            }
+            planned += 1;
+        }
+        assert!(planned >= 40, "{planned}");
+    }
+
     #[test]
     fn the_shortest_path_is_the_taut_string_round_the_wall() {
         let ws = ws();
