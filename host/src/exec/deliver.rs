@@ -493,9 +493,9 @@ pub fn deliver_learned_among(
         // goal, or the path's sub-goal) or off it by more than the re-position angle, or did
         // not move it at all (the robot lost contact), or — near the boundary — towards the
         // boundary.
+        let off_by = wrap_angle(angle_of(moved) - angle_of(to_aim)).abs();
         special = moved.norm() < p.moved_epsilon
-            || moved.dot(&to_aim) < 0.0
-            || wrap_angle(angle_of(moved) - angle_of(to_aim)).abs() > p.reposition_angle
+            || off_by > p.reposition_angle.min(std::f64::consts::FRAC_PI_2)
             || moved.dot(&bias) < 0.0;
     }
 }

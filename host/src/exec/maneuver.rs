@@ -216,23 +216,21 @@ pub fn circle_walk(
         r.theta + std::f64::consts::PI
     };
     let around = around_object(&ws, obstacles, centre, radius);
-    if !obstacles.is_empty() && circle_cut(&ws, obstacles, &on, from, to, rel.norm() < radius) {
-        // An obstacle cuts the circle both ways (a corridor, a wall's end) or stands where the
-        // robot would join it: go to the stand point by a path around the obstacles and the
-        // object instead.
-        if rel.norm() < radius {
-            face(io, angle_of(-rel), &Turn::two_level(tol))?;
-            let back = clamp(on(from)) - io.robot_pose().position();
-            io.forward(-back.norm())?;
-        }
-        return transit(io, on(to), &around, &Drive::two_level(tol));
-    }
-    if rel.norm() < radius {
+    let inside = rel.norm() < radius;
+    // An obstacle cuts the circle both ways (a corridor, a wall's end) or stands where the
+    // robot would join it: the stand point is reached by a path around the obstacles and the
+    // object instead.
+    let cut = !obstacles.is_empty() && circle_cut(&ws, obstacles, &on, from, to, inside);
+    if inside {
         // Back straight away from the centre onto the circle.
         face(io, angle_of(-rel), &Turn::two_level(tol))?;
         let back = clamp(on(from)) - io.robot_pose().position();
         io.forward(-back.norm())?;
-    } else {
+    }
+    if cut {
+        return transit(io, on(to), &around, &Drive::two_level(tol));
+    }
+    if !inside {
         // From afar, around the obstacles and the object itself.
         transit(io, clamp(on(from)), &around, &Drive::two_level(tol))?;
     }
