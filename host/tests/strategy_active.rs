@@ -64,3 +64,28 @@ fn the_data_need_curve_of_the_active_collection_reaches_the_streak_within_300_sa
     assert_eq!(samples.len(), n);
     assert_eq!(again.evaluation_pushes, rep.evaluation_pushes);
 }
+
+#[test]
+fn the_exploring_collection_chooses_its_own_pushes() {
+    // `--selection explore` is wired to the initial collection: 40 pushes of the L-shape, each
+    // a sample, reproducible from the seed, and not the pushes the uncertain selection makes.
+    let scene = Scene::preset("lau-l-shape").unwrap();
+    let s = setup();
+    let params = |selection| CollectParams {
+        initial: 40,
+        streak: 0,
+        selection,
+        ..CollectParams::default()
+    };
+    let (explore, rep) = collect_clear(&scene, &params(Selection::Explore), &s).unwrap();
+    assert_eq!(rep.initial_samples, 40, "{rep:?}");
+    assert_eq!(explore.len(), 40);
+    let (again, _) = collect_clear(&scene, &params(Selection::Explore), &s).unwrap();
+    assert_eq!(again, explore);
+    let (uncertain, _) = collect_clear(&scene, &params(Selection::Uncertain), &s).unwrap();
+    assert_eq!(uncertain.len(), 40);
+    // The first push is the same (no samples yet: every candidate is unknown alike); after it
+    // the two selections part.
+    assert_eq!(uncertain[0], explore[0]);
+    assert_ne!(uncertain, explore);
+}

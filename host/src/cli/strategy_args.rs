@@ -64,6 +64,10 @@ pub enum SelectionArg {
     Random,
     /// Of several random pushes, the one the strategy knows least.
     Uncertain,
+    /// Of several random pushes, the one that, with the contact it leads the robot to, the
+    /// strategy knows least (measured: better for an L-shape among walls, worse for the wire
+    /// cutter; see the README).
+    Explore,
 }
 
 /// Which pushes of the collection's evaluation become samples.
@@ -108,6 +112,7 @@ impl ActiveArgs {
             selection: match self.selection {
                 SelectionArg::Random => Selection::Random,
                 SelectionArg::Uncertain => Selection::Uncertain,
+                SelectionArg::Explore => Selection::Explore,
             },
             admission: match self.keep {
                 KeepArg::All => None,

@@ -323,7 +323,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
             pb.inc(res.trials as u64);
             if !global.json {
                 let line = format!(
-                    "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} ({} shortest, worst {}) | failures {:?} | stalls recovered {}",
+                    "{} {} {:>7}: {:>5.1} % of {} | time {} | object path {} ({} shortest, worst {}) | failures {:?} | stalls recovered {} | time-outs without a recovery {}",
                     scene.name,
                     res.start,
                     format!("{:?}", res.method),
@@ -338,6 +338,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
                         .map_or("-".into(), |t| format!("{t:.2}×")),
                     res.failures,
                     res.stall_recoveries,
+                    res.silent_timeouts,
                 );
                 // A hidden bar (output not a terminal) prints nothing.
                 if pb.is_hidden() {

@@ -20,7 +20,8 @@
 //! the one of [`CollectParams::candidates`] random pushes the strategy knows least
 //! ([`Selection::Uncertain`], [`crate::strategy::active`]); the initial collection is short and
 //! the evaluation, which stops at the streak, does the rest; and the evaluation keeps only the
-//! pushes that teach the strategy something ([`Admission`]). `Selection::Random`, `initial`
+//! pushes that teach the strategy something ([`Admission`]). [`Selection::Explore`] also prefers
+//! pushes that lead the robot to contacts it has not pushed from. `Selection::Random`, `initial`
 //! 300 and `admission: None` are the paper's Algorithm 1.
 
 use anyhow::Result;
@@ -32,7 +33,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::exec::deliver::{DeliveryParams, Failure, bound_all_radius, deliver_learned};
 use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{Turn, circle_walk, face};
-use crate::strategy::active::{Selection, least_known};
+use crate::strategy::active::{Selection, least_known, least_known_ahead};
 use crate::strategy::regression::{Admission, PushStrategy};
 use crate::strategy::sample::Sample;
 
@@ -288,9 +289,10 @@ pub fn safe_spin(
     best.1
 }
 
-/// [`Selection::Uncertain`]'s push: of `params.candidates` random (spin, length) pairs whose push
-/// keeps the object's marker inside the boundary, the one the strategy knows least
-/// ([`least_known`] in the object's frame); when none is safe, [`safe_spin`]'s.
+/// [`Selection::Uncertain`]'s and [`Selection::Explore`]'s push: of `params.candidates` random
+/// (spin, length) pairs whose push keeps the object's marker inside the boundary, the one the
+/// strategy knows least ([`least_known`], or [`least_known_ahead`] when exploring, in the
+/// object's frame); when none is safe, [`safe_spin`]'s.
 fn uncertain_push(
     io: &mut dyn RobotIo,
     rng: &mut ChaCha8Rng,
@@ -314,7 +316,11 @@ fn uncertain_push(
         motions.push([m.x, m.y]);
     }
     let width = strategy.params().kernel_width;
-    match least_known(strategy.samples(), [p.x, p.y], &motions, width) {
+    let pick = match params.selection {
+        Selection::Explore => least_known_ahead,
+        _ => least_known,
+    };
+    match pick(strategy.samples(), [p.x, p.y], &motions, width) {
         Some(i) => pushes[i],
         None => {
             let first = rng.random_range(-params.spin_max..=params.spin_max);
@@ -418,7 +424,9 @@ pub fn collect(
                 let angle = safe_spin(io, &mut rng, first, params);
                 (angle, rng.random_range(params.push_min..=params.push_max))
             }
-            Selection::Uncertain => uncertain_push(io, &mut rng, strategy, params),
+            Selection::Uncertain | Selection::Explore => {
+                uncertain_push(io, &mut rng, strategy, params)
+            }
         };
         io.spin(angle)?;
         let (r0, o0) = (io.robot_pose(), io.object_pose());

@@ -110,7 +110,8 @@ pub fn fig11_svg(
             let sx = x0 + i as f64 * slot + slot * 0.1;
             for (j, m) in methods.iter().enumerate() {
                 let Some(pct) = rate(e, s, *m) else { continue };
-                let bh = ph * pct.clamp(0.0, 100.0) / 100.0;
+                // A 0 % bar is a 1-unit line, so the cell is seen to have been run (and has its tip).
+                let bh = (ph * pct.clamp(0.0, 100.0) / 100.0).max(1.0);
                 g.rect(
                     [sx + j as f64 * bar, y0 + ph - bh],
                     [bar * 0.92, bh],
@@ -166,6 +167,7 @@ mod tests {
             max_path_ratio: None,
             failures: Default::default(),
             stall_recoveries: 0,
+            silent_timeouts: 0,
         }
     }
 
@@ -181,7 +183,7 @@ mod tests {
             results: vec![
                 result("A", Method::Dipole, 1),
                 result("A", Method::Learned, 4),
-                result("B", Method::Dipole, 2),
+                result("B", Method::Dipole, 0),
                 result("B", Method::Learned, 3),
             ],
         }];
@@ -194,10 +196,17 @@ mod tests {
         let full = format!("height=\"{}\"", PLOT[1]);
         assert_eq!(svg.matches(&full).count(), 1, "one bar at 100 %: {svg}");
         assert!(svg.contains("B ours: 75 %") && svg.contains("snake (120 samples)"));
+        // A cell with no success is still drawn (a 1-unit bar with its tip), never a rectangle
+        // without height, which renderers reject.
+        assert!(
+            svg.contains("height=\"1\"") && svg.contains("B dipole: 0 %"),
+            "{svg}"
+        );
+        assert!(!svg.contains("height=\"0\""), "{svg}");
         let table = fig11_table(&evals, &starts, &methods);
         let rows: Vec<&str> = table.lines().collect();
         assert_eq!(rows.len(), 4);
         assert!(rows[2].contains("25") && rows[2].contains("100"), "{table}");
-        assert!(rows[3].contains("50") && rows[3].contains("75"), "{table}");
+        assert!(rows[3].contains(" 0") && rows[3].contains("75"), "{table}");
     }
 }

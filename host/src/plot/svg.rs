@@ -200,7 +200,8 @@ pub trait Draw {
 
     /// A rectangle with top-left corner `at` and size `size`.
     fn rect(&mut self, at: [f64; 2], size: [f64; 2], style: &Style) {
-        if finite(at) && finite(size) {
+        // SVG draws nothing of a rectangle without area, and renderers reject one of negative size.
+        if finite(at) && finite(size) && size[0] > 0.0 && size[1] > 0.0 {
             let a = [
                 ("x", at[0]),
                 ("y", at[1]),
@@ -500,6 +501,9 @@ mod tests {
         g.circle([1.0, 1.0], f64::NAN, &Style::new());
         g.polygon(&[[f64::NAN, 0.0]], &Style::new());
         g.circle([1.0, 2.0], 3.0, &Style::outline("red", 1.5).dash("2,3"));
+        // A rectangle without area (a 0 % bar) or of negative size is not written.
+        g.rect([0.0, 0.0], [4.0, 0.0], &Style::new());
+        g.rect([0.0, 0.0], [-1.0, 2.0], &Style::new());
         let mut d = Doc::new(10.0, 10.0);
         d.group(g);
         let s = d.to_string();
