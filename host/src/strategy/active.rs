@@ -40,17 +40,24 @@ impl Selection {
 /// the samples, d the distance in (p_x, p_y, r_x, r_y). Near 0 where the strategy has never
 /// pushed.
 pub fn push_density(samples: &[Sample], p: [f64; 2], r: [f64; 2], width: f64) -> f64 {
-    let w2 = width * width;
-    samples
-        .iter()
-        .map(|s| {
-            let d2 = (s.p[0] - p[0]).powi(2)
-                + (s.p[1] - p[1]).powi(2)
-                + (s.r[0] - r[0]).powi(2)
-                + (s.r[1] - r[1]).powi(2);
-            (-d2 / w2).exp()
-        })
-        .sum()
+    samples.iter().map(|s| kernel(s, p, r, width)).sum()
+}
+
+/// One sample's Gaussian weight around the push r from p: exp(−d²/w²), d in (p, r).
+fn kernel(s: &Sample, p: [f64; 2], r: [f64; 2], width: f64) -> f64 {
+    let d2 = (s.p[0] - p[0]).powi(2)
+        + (s.p[1] - p[1]).powi(2)
+        + (s.r[0] - r[0]).powi(2)
+        + (s.r[1] - r[1]).powi(2);
+    (-d2 / (width * width)).exp()
+}
+
+/// Index of the least score, the first on ties; `None` without scores.
+fn least(scores: impl Iterator<Item = f64>) -> Option<usize> {
+    scores
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
 }
 
 /// Index of the candidate robot motion (object frame, from `p`) with the least
@@ -61,26 +68,20 @@ pub fn least_known(
     candidates: &[[f64; 2]],
     width: f64,
 ) -> Option<usize> {
-    candidates
-        .iter()
-        .map(|r| push_density(samples, p, *r, width))
-        .enumerate()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(i, _)| i)
+    least(
+        candidates
+            .iter()
+            .map(|r| push_density(samples, p, *r, width)),
+    )
 }
 
 /// Where the robot is expected to touch the object after the push `r` from `p` (object frame,
 /// in the object's frame after the push): `p + r − s` turned by `−θ`, with `s` and `θ` the
 /// [`push_density`]-weighted means of the samples around (p, r). `None` where no sample is near.
 pub fn next_contact(samples: &[Sample], p: [f64; 2], r: [f64; 2], width: f64) -> Option<[f64; 2]> {
-    let w2 = width * width;
     let (mut sum, mut sx, mut sy, mut st) = (0.0, 0.0, 0.0, 0.0);
     for s in samples {
-        let d2 = (s.p[0] - p[0]).powi(2)
-            + (s.p[1] - p[1]).powi(2)
-            + (s.r[0] - r[0]).powi(2)
-            + (s.r[1] - r[1]).powi(2);
-        let w = (-d2 / w2).exp();
+        let w = kernel(s, p, r, width);
         sum += w;
         sx += w * s.s[0];
         sy += w * s.s[1];
@@ -113,16 +114,11 @@ pub fn least_known_ahead(
     candidates: &[[f64; 2]],
     width: f64,
 ) -> Option<usize> {
-    candidates
-        .iter()
-        .map(|r| {
-            let ahead = next_contact(samples, p, *r, width)
-                .map_or(0.0, |q| contact_density(samples, q, width));
-            push_density(samples, p, *r, width) + ahead
-        })
-        .enumerate()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(i, _)| i)
+    least(candidates.iter().map(|r| {
+        let ahead =
+            next_contact(samples, p, *r, width).map_or(0.0, |q| contact_density(samples, q, width));
+        push_density(samples, p, *r, width) + ahead
+    }))
 }
 
 #[cfg(test)]
