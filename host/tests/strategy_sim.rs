@@ -55,7 +55,7 @@ fn collect_samples(
     )
     .unwrap();
     assert_eq!(rep.initial_samples, k, "{rep:?}");
-    assert_eq!(strat.len(), k);
+    assert_eq!(strat.len(), k + rep.coverage_samples);
     strat.samples().to_vec()
 }
 

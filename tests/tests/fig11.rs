@@ -42,7 +42,15 @@ fn figure_11_runs_every_cell_and_draws_them() {
     let mut cells = 0;
     for s in scenes {
         assert!(s["scene"].as_str().unwrap().starts_with("lau-"));
-        assert_eq!(s["samples"].as_u64(), Some(40), "{s}");
+        // 40 initial pushes, then the exploring collection's push for each way of moving the
+        // object they did not cover.
+        let c = &s["collection"];
+        assert_eq!(c["initial_samples"].as_u64(), Some(40), "{s}");
+        assert_eq!(
+            s["samples"].as_u64(),
+            Some(40 + c["coverage_samples"].as_u64().unwrap()),
+            "{s}"
+        );
         let results = s["results"].as_array().unwrap();
         assert_eq!(results.len(), 4, "starts A and F × both methods: {s}");
         cells += results.len();

@@ -89,7 +89,7 @@ pub(super) fn run_figure7(global: &Global, a: &DeliveryArgs) -> CliResult {
     // Done when the active collection reaches the streak within 300 samples on every object.
     let ok = curves
         .iter()
-        .filter(|c| c.variant.name == "uncertain")
+        .filter(|c| c.variant.name == "explore")
         .all(|c| c.streak_at.is_some_and(|n| n <= 300));
     Ok(if ok {
         Status::Success

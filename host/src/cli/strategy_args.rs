@@ -65,8 +65,7 @@ pub enum SelectionArg {
     /// Of several random pushes, the one the strategy knows least.
     Uncertain,
     /// Of several random pushes, the one that, with the contact it leads the robot to, the
-    /// strategy knows least (measured: better for an L-shape among walls, worse for the wire
-    /// cutter; see the README).
+    /// strategy knows least; then a push for each way of moving the object no sample covers.
     Explore,
 }
 
@@ -83,7 +82,7 @@ pub enum KeepArg {
 #[derive(Args, Debug, Clone)]
 pub struct ActiveArgs {
     /// How the initial collection chooses its pushes.
-    #[arg(long, value_enum, default_value_t = SelectionArg::Uncertain)]
+    #[arg(long, value_enum, default_value_t = SelectionArg::Explore)]
     pub selection: SelectionArg,
     /// Which pushes of the collection's evaluation are kept as samples.
     #[arg(long, value_enum, default_value_t = KeepArg::Informative)]

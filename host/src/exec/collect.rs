@@ -17,12 +17,13 @@
 //! collection ends with the object inside the boundary.
 //!
 //! Fewer samples than the paper (issue 24): each push of the initial collection is, by default,
-//! the one of [`CollectParams::candidates`] random pushes the strategy knows least
-//! ([`Selection::Uncertain`], [`crate::strategy::active`]); the initial collection is short and
-//! the evaluation, which stops at the streak, does the rest; and the evaluation keeps only the
-//! pushes that teach the strategy something ([`Admission`]). [`Selection::Explore`] also prefers
-//! pushes that lead the robot to contacts it has not pushed from. `Selection::Random`, `initial`
-//! 300 and `admission: None` are the paper's Algorithm 1.
+//! the one of [`CollectParams::candidates`] random pushes that, with the contact it leads the
+//! robot to, the strategy knows least ([`Selection::Explore`], [`crate::strategy::active`]), and
+//! the initial collection ends with a push for each way of moving the object (every 45°) its
+//! samples do not cover ([`uncovered`]); the initial collection is short and the evaluation,
+//! which stops at the streak, does the rest; and the evaluation keeps only the pushes that teach
+//! the strategy something ([`Admission`]). `Selection::Random`, `initial` 300 and
+//! `admission: None` are the paper's Algorithm 1.
 
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -62,7 +63,7 @@ pub struct CollectParams {
     pub seed: u64,
     /// How the initial collection chooses its pushes.
     pub selection: Selection,
-    /// Random candidate pushes [`Selection::Uncertain`] chooses among.
+    /// Random candidate pushes [`Selection::Uncertain`] and [`Selection::Explore`] choose among.
     pub candidates: usize,
     /// Which pushes of the evaluation are kept as supplemental samples (`None`: all, the paper).
     pub admission: Option<Admission>,
@@ -86,7 +87,7 @@ impl Default for CollectParams {
             // over_time_limit(): the paper's 8 minutes, as in its trials.
             delivery: DeliveryParams::default(),
             seed: 1,
-            selection: Selection::Uncertain,
+            selection: Selection::Explore,
             candidates: 12,
             admission: Some(Admission::default()),
         }
@@ -100,6 +101,11 @@ pub struct CollectReport {
     pub initial_samples: usize,
     /// Supplemental samples from the evaluation's queries.
     pub supplemental_samples: usize,
+    /// [`Selection::Explore`]'s coverage pushes after the initial collection: one for each way
+    /// of moving the object (every 45°) no sample covered.
+    pub coverage_pushes: usize,
+    /// Samples from those pushes (the others found no stand point or did not move the object).
+    pub coverage_samples: usize,
     /// Pushes the evaluation's queries made (kept as samples or not).
     pub evaluation_pushes: usize,
     /// Samples in the strategy at the end (including any loaded before).
@@ -316,7 +322,12 @@ fn uncertain_push(
         motions.push([m.x, m.y]);
     }
     let width = strategy.params().kernel_width;
+    let alt: usize = std::env::var("PB_ALT")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
     let pick = match params.selection {
+        Selection::Explore if alt > 0 && strategy.len() % alt != 0 => least_known,
         Selection::Explore => least_known_ahead,
         _ => least_known,
     };
@@ -328,6 +339,57 @@ fn uncertain_push(
             (angle, rng.random_range(params.push_min..=params.push_max))
         }
     }
+}
+
+/// A way of moving the object counts as covered by a sample that moved it at least this far
+/// within 22.5° of it, m.
+pub const COVERED: f64 = 0.01;
+
+/// The object-frame directions of motion, every 45° from the object's +x, that no sample moved
+/// the object along (within 22.5°) by at least `min` m: ways the strategy cannot push it.
+pub fn uncovered(samples: &[Sample], min: f64) -> Vec<f64> {
+    let bin = std::f64::consts::FRAC_PI_4;
+    let mut seen = [false; 8];
+    for s in samples.iter().filter(|s| s.s_len() >= min) {
+        let k = (s.s[1].atan2(s.s[0]) / bin).round().rem_euclid(8.0) as usize;
+        seen[k % 8] = true;
+    }
+    (0..8)
+        .filter(|&k| !seen[k])
+        .map(|k| k as f64 * bin)
+        .collect()
+}
+
+/// A push meant to move the object along `dir` (object frame, rad): round the bound-all circle
+/// to the side opposite that way, face the marker and push. The sample, or `None` when the
+/// robot cannot stand there or the object did not move.
+fn coverage_push(
+    io: &mut dyn RobotIo,
+    dir: f64,
+    margin: f64,
+    params: &CollectParams,
+) -> Result<Option<Sample>> {
+    let ws = io.workspace();
+    let radius = bound_all_radius(&ws, margin);
+    let o = io.object_pose();
+    let stand_angle = o.theta + dir + std::f64::consts::PI;
+    let stand = o.position() + radius * Vector2::new(stand_angle.cos(), stand_angle.sin());
+    if !ws.reachable().contains(stand) {
+        return Ok(None);
+    }
+    circle_walk(io, o.position(), radius, stand_angle, 0.05, &[])?;
+    // reset_robot's approach (face the marker, creep until the object moves), then a push
+    // straight on, as the initial collection's pushes start from a touch.
+    if !reset_robot(io, params.epsilon)? {
+        return Ok(None);
+    }
+    let (r0, o0) = (io.robot_pose(), io.object_pose());
+    io.forward((params.push_min + params.push_max) / 2.0)?;
+    let (r1, o1) = (io.robot_pose(), io.object_pose());
+    if (o1.position() - o0.position()).norm() < params.epsilon {
+        return Ok(None);
+    }
+    Ok(Some(Sample::from_push(r0, r1, o0, o1)))
 }
 
 /// The error [`collect`] stops with when the object cannot be pushed back inside.
@@ -445,6 +507,23 @@ pub fn collect(
     }
     rep.initial_minutes = (io.time() - t0) / 60.0;
 
+    // Exploring: a push for every way of moving the object the samples do not cover yet.
+    if params.selection == Selection::Explore {
+        for dir in uncovered(strategy.samples(), COVERED) {
+            if outside(io) {
+                rep.boundary_resets += bring_inside(io, margin, params.epsilon)?;
+            }
+            rep.coverage_pushes += 1;
+            if let Some(s) = coverage_push(io, dir, margin, params)? {
+                strategy.add(s);
+                sink(&s)?;
+                rep.coverage_samples += 1;
+            }
+            progress(pb, strategy, &rep, io.time() - t0);
+        }
+        rep.initial_minutes = (io.time() - t0) / 60.0;
+    }
+
     // Experimental evaluation of existing data.
     strategy.set_admission(params.admission);
     let mut streak = 0;
@@ -496,4 +575,39 @@ pub fn collect(
     rep.total_samples = strategy.len();
     rep.total_minutes = (io.time() - t0) / 60.0;
     Ok(rep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_4, PI};
+
+    fn moved(s: [f64; 2]) -> Sample {
+        Sample {
+            p: [-0.1, 0.0],
+            r: [0.04, 0.0],
+            s,
+            theta: 0.0,
+        }
+    }
+
+    #[test]
+    fn uncovered_ways_are_those_no_sample_moved_the_object_far_enough() {
+        // +x by 1.5 cm and −x by 1.2 cm are covered (−x at −179°, in the bin of 180°); +y only
+        // by 5 mm, which is too little; 30° by 2 cm falls in the 45° bin.
+        let samples = [
+            moved([0.015, 0.0]),
+            moved([-0.012, -0.0002]),
+            moved([0.0, 0.005]),
+            moved([0.02 * 0.5236f64.cos(), 0.02 * 0.5236f64.sin()]),
+        ];
+        let left = uncovered(&samples, COVERED);
+        let want = [2.0, 3.0, 5.0, 6.0, 7.0].map(|k| k * FRAC_PI_4);
+        assert_eq!(left.len(), want.len(), "{left:?}");
+        for (a, b) in left.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{left:?}");
+        }
+        assert!(!left.iter().any(|a| (a - PI).abs() < 1e-9));
+        assert_eq!(uncovered(&[], COVERED).len(), 8);
+    }
 }

@@ -36,9 +36,9 @@ pub struct Variant {
 }
 
 /// The curves drawn: the paper's Algorithm 1 (random pushes, K = 300, every push kept), and the
-/// active collection with random and with uncertain initial pushes (K = [`DEFAULT_INITIAL`],
-/// informative pushes kept).
-pub const VARIANTS: [Variant; 3] = [
+/// active collection with random, uncertain and exploring initial pushes (K =
+/// [`DEFAULT_INITIAL`], informative pushes kept; exploring is the default).
+pub const VARIANTS: [Variant; 4] = [
     Variant {
         name: "paper",
         selection: Selection::Random,
@@ -54,6 +54,12 @@ pub const VARIANTS: [Variant; 3] = [
     Variant {
         name: "uncertain",
         selection: Selection::Uncertain,
+        initial: DEFAULT_INITIAL,
+        informative: true,
+    },
+    Variant {
+        name: "explore",
+        selection: Selection::Explore,
         initial: DEFAULT_INITIAL,
         informative: true,
     },
@@ -255,11 +261,12 @@ pub fn table(curves: &[Curve]) -> String {
             .streak_at
             .map_or("not reached".to_owned(), |n| format!("{n} samples"));
         out += &format!(
-            "{:<22} {:<10} streak at {:<12} ({} initial + {} supplemental of {} evaluation pushes, {} queries, {:.0} min)\n",
+            "{:<22} {:<10} streak at {:<12} ({} initial + {} coverage + {} supplemental of {} evaluation pushes, {} queries, {:.0} min)\n",
             c.scene,
             c.variant.name,
             streak,
             c.collection.initial_samples,
+            c.collection.coverage_samples,
             c.collection.supplemental_samples,
             c.collection.evaluation_pushes,
             c.collection.queries,

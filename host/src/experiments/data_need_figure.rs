@@ -19,6 +19,7 @@ fn colour(variant: &str) -> &'static str {
     match variant {
         "paper" => "#777",
         "random" => "#e08000",
+        "uncertain" => "#20a060",
         _ => "#1060c0",
     }
 }
