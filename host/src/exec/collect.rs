@@ -322,12 +322,7 @@ fn uncertain_push(
         motions.push([m.x, m.y]);
     }
     let width = strategy.params().kernel_width;
-    let alt: usize = std::env::var("PB_ALT")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0);
     let pick = match params.selection {
-        Selection::Explore if alt > 0 && strategy.len() % alt != 0 => least_known,
         Selection::Explore => least_known_ahead,
         _ => least_known,
     };
@@ -580,7 +575,7 @@ pub fn collect(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::{FRAC_PI_4, PI};
+    use std::f64::consts::{FRAC_PI_4, FRAC_PI_6, PI};
 
     fn moved(s: [f64; 2]) -> Sample {
         Sample {
@@ -599,7 +594,7 @@ mod tests {
             moved([0.015, 0.0]),
             moved([-0.012, -0.0002]),
             moved([0.0, 0.005]),
-            moved([0.02 * 0.5236f64.cos(), 0.02 * 0.5236f64.sin()]),
+            moved([0.02 * FRAC_PI_6.cos(), 0.02 * FRAC_PI_6.sin()]),
         ];
         let left = uncovered(&samples, COVERED);
         let want = [2.0, 3.0, 5.0, 6.0, 7.0].map(|k| k * FRAC_PI_4);
