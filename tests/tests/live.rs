@@ -312,6 +312,46 @@ fn a_robot_lost_for_good_stops_the_task() {
     t.shutdown().expect("sim ran cleanly");
 }
 
+/// The robot against the wire cutter's jaws covers their marker (which overhangs them) with its
+/// own: the live robot backs away, sees the object, comes back, and reports both poses from
+/// after it (`exec::occlusion`), as the in-process robot does.
+#[test]
+fn a_robot_that_hides_the_object_backs_away_looks_and_comes_back() {
+    let mut scene = Scene::preset("lau-wire-cutter").expect("preset");
+    // The object lies along x: its jaws' marker is 3 cm ahead of its origin.
+    let o = scene.objects[0].pose;
+    assert_eq!(o.theta, 0.0);
+    scene.robot.start = pushbot_sim::Pose::new(
+        o.x + 0.03,
+        o.y - 0.0135 - 0.04 - 0.0015,
+        std::f64::consts::FRAC_PI_2,
+    );
+    let t = target(&scene, 10);
+    let mut robot = LiveRobot::connect(t.port(), t.camera(), &scene, options()).expect("connect");
+    let start = t.sim().truth().pose;
+    let seen = robot.object_pose();
+    let (_, b) = t.sim().objects()[0].clone();
+    let marker = pushbot_sim::Pose::new(
+        b.x + 0.03 * b.theta.cos(),
+        b.y + 0.03 * b.theta.sin(),
+        b.theta,
+    );
+    close(seen, marker, 3.0, 1.5);
+    let end = t.sim().truth().pose;
+    assert!(
+        (end.x - start.x).hypot(end.y - start.y) < 0.01,
+        "the robot did not come back: {start:?} → {end:?}"
+    );
+    close(robot.robot_pose(), end, 3.0, 1.5);
+    assert_eq!(
+        robot.relooks(),
+        1,
+        "the object was seen without backing away"
+    );
+    drop(robot);
+    t.shutdown().expect("sim ran cleanly");
+}
+
 /// The whole pipeline through the serial port and the camera socket on a camera as it is: a
 /// webcam lens, tilted 35° from straight down at the table's near edge, the robot's marker 6 cm
 /// and the object's 3 cm above the table. Each primitive's end is seen within 3 mm and 1.5°.

@@ -106,6 +106,9 @@ pub enum Failure {
     NoPath,
     /// No progress towards the goal for the stall time, after every recovery was tried.
     Stalled,
+    /// The camera lost the object (or the robot): not seen after the robot stopped, nor after
+    /// it backed away ([`crate::exec::occlusion::BodyLost`]).
+    MarkerLost,
 }
 
 /// A stall among obstacles and what was done about it.
@@ -149,6 +152,25 @@ pub struct Delivery {
     /// Robot and object poses after every step (Fig. 8).
     #[serde(skip)]
     pub trajectory: Vec<(Pose2, Pose2)>,
+}
+
+impl Delivery {
+    /// A delivery that has not (yet) reached the goal: nothing pushed, nothing travelled.
+    pub fn failed(failure: Option<Failure>, time: f64, final_distance: f64) -> Delivery {
+        Delivery {
+            success: false,
+            failure,
+            time,
+            steps: 0,
+            repositions: 0,
+            recoveries: Vec::new(),
+            object_path: 0.0,
+            robot_path: 0.0,
+            shortest_path: None,
+            final_distance,
+            trajectory: Vec::new(),
+        }
+    }
 }
 
 /// Radius of the bound-all circle (Fig. 3): object bounding radius + robot radius + margin.

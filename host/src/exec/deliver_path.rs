@@ -47,19 +47,7 @@ pub fn deliver_among_obstacles(
 ) -> Result<ObstacleDelivery> {
     let start = io.time();
     let ws = io.workspace();
-    let mut all = Delivery {
-        success: false,
-        failure: None,
-        time: 0.0,
-        steps: 0,
-        repositions: 0,
-        recoveries: Vec::new(),
-        object_path: 0.0,
-        robot_path: 0.0,
-        shortest_path: None,
-        final_distance: f64::NAN,
-        trajectory: Vec::new(),
-    };
+    let mut all = Delivery::failed(None, 0.0, f64::NAN);
     let mut subgoals = Vec::new();
     let mut first_path = Vec::new();
     // Look-ahead of the moving sub-goal: halved at each stall in a row (the object is then

@@ -17,6 +17,7 @@ use pushbot_protocol::Outcome;
 use pushbot_world::Scene;
 
 use super::grabber::FrameGrabber;
+use super::occlusion::{self, BodyLost};
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::link::LinkError;
 use crate::robot::{LinkOptions, Recovery, Robot, link_broke};
@@ -116,6 +117,10 @@ pub struct LiveRobot {
     look_from: f64,
     /// Why the camera stopped, once it has: the next primitive fails with it.
     camera_error: Option<String>,
+    /// The body the camera lost, once it has: the next primitive fails with it.
+    lost: Option<BodyLost>,
+    /// Bodies seen again after the robot backed away ([`occlusion`]).
+    relooks: usize,
     t0_us: u64,
     /// Wall instant and robot clock (s) when the robot last went idle (end of a primitive).
     idle_since: (std::time::Instant, f64),
@@ -235,6 +240,8 @@ impl LiveRobot {
             fresh: false,
             look_from: f64::NEG_INFINITY,
             camera_error: None,
+            lost: None,
+            relooks: 0,
             t0_us,
             idle_since: (std::time::Instant::now(), 0.0),
             host_adjust: 0.0,
@@ -279,6 +286,11 @@ impl LiveRobot {
     /// Frames processed so far.
     pub fn frames_seen(&self) -> u64 {
         self.frames_seen
+    }
+
+    /// Times a body the camera did not see was seen again after the robot backed away.
+    pub fn relooks(&self) -> usize {
+        self.relooks
     }
 
     /// The latest pose of a tracked body (`robot`, an object id or `goal:<object id>`), with
@@ -355,17 +367,18 @@ impl LiveRobot {
         Ok((n, frame.time))
     }
 
+    /// Whether the camera has seen `body` since the latest look began.
+    fn seen_since_look(&self, body: &str) -> bool {
+        self.poses
+            .get(body)
+            .is_some_and(|(_, t)| *t >= self.look_from)
+    }
+
     /// The robot stands still between primitives: a body the latest look did not see is
-    /// waited for, frame by frame, up to `reacquire_frames`; still unseen, it is lost and the
-    /// task stops (the next primitive fails with it) rather than act on an old pose.
-    fn reacquire(&mut self, body: &str) {
-        if self.camera_error.is_some()
-            || self
-                .poses
-                .get(body)
-                .is_some_and(|(_, t)| *t >= self.look_from)
-        {
-            return;
+    /// waited for, frame by frame, up to `reacquire_frames`; whether it was seen.
+    fn reacquire(&mut self, body: &str) -> bool {
+        if self.camera_error.is_some() || self.seen_since_look(body) {
+            return self.seen_since_look(body);
         }
         let mut after = self.grabber.count();
         for k in 0..self.opts.reacquire_frames {
@@ -373,39 +386,94 @@ impl LiveRobot {
                 Ok((n, _)) => after = n,
                 Err(e) => {
                     self.camera_error = Some(format!("{e:#}"));
+                    return false;
+                }
+            }
+            if self.seen_since_look(body) {
+                tracing::info!("{body} seen again after {} frame(s)", k + 1);
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Wait for `body`; unseen, the robot backs away ([`occlusion`]: it may hide the body
+    /// itself), looks again and comes back; still unseen, it is lost and the task stops (the
+    /// next primitive fails with it) rather than act on an old pose.
+    fn make_sure_of(&mut self, body: &str) {
+        if self.lost.is_some() || self.camera_error.is_some() || self.seen_since_look(body) {
+            return;
+        }
+        let robot = self.poses.get("robot").map(|(p, _)| *p);
+        let body_at = self.poses.get(body).map(|(p, _)| p.position());
+        // A body the robot hides does not come back by waiting.
+        if !occlusion::robot_may_hide(body, robot, body_at)
+            && (self.reacquire(body) || self.camera_error.is_some())
+        {
+            return;
+        }
+        // (A robot never seen cannot be moved with any sense: the body is lost.)
+        let moves = robot.map_or_else(Vec::new, |r| occlusion::back_offs(r, body_at).to_vec());
+        for d in moves {
+            tracing::info!("{body} not seen: the robot moves {d:+.2} m and looks again");
+            let seen = self
+                .back_off(d)
+                .and_then(|()| self.look())
+                .map(|()| self.reacquire(body));
+            // Come back to where the robot stood: the body did not move meanwhile.
+            let away = self.look_from;
+            let back = self.back_off(-d).and_then(|()| self.look());
+            match (seen, back) {
+                (Ok(seen), Ok(())) => {
+                    self.reacquire("robot");
+                    if seen {
+                        self.look_from = away;
+                        self.relooks += 1;
+                        return;
+                    }
+                }
+                (Err(e), _) | (_, Err(e)) => {
+                    self.camera_error = Some(format!("moving to look for {body}: {e:#}"));
                     return;
                 }
             }
-            if self
-                .poses
-                .get(body)
-                .is_some_and(|(_, t)| *t >= self.look_from)
-            {
-                tracing::info!("{body} seen again after {} frame(s)", k + 1);
-                return;
-            }
         }
         tracing::warn!("{body} lost");
-        self.camera_error = Some(format!(
-            "{body} is lost: the camera has not seen its marker in {} frames since the robot \
-             stopped (occluded, out of view, or the marker is gone)",
-            self.opts.reacquire_frames + self.opts.frames_per_look.max(1)
-        ));
+        self.lost = Some(BodyLost {
+            body: body.to_owned(),
+        });
     }
 
+    /// One of [`occlusion::back_offs`]' moves, at [`occlusion::BACK_OFF_SPEED`].
+    fn back_off(&mut self, d: f64) -> Result<()> {
+        let speed = occlusion::BACK_OFF_SPEED as f32;
+        self.motion("move", |r| {
+            Ok(r.move_distance(d as f32, speed, false)?.outcome)
+        })
+    }
+
+    /// Look once after a motion, and make sure of the robot and the object: every pose
+    /// reported is from after any backing away.
     fn look_if_stale(&mut self) {
-        if self.fresh || self.camera_error.is_some() {
+        if self.fresh || self.camera_error.is_some() || self.lost.is_some() {
             return;
         }
         if let Err(e) = self.look() {
             tracing::warn!("camera: {e:#}");
             self.camera_error = Some(format!("{e:#}"));
+            return;
+        }
+        self.make_sure_of("robot");
+        if let Some(object) = self.object.clone() {
+            self.make_sure_of(&object);
         }
     }
 
     fn pose_of(&mut self, body: &str) -> Pose2 {
         self.look_if_stale();
-        self.reacquire(body);
+        if !self.seen_since_look(body) {
+            self.make_sure_of(body);
+        }
         self.poses
             .get(body)
             .map_or(Pose2::new(f64::NAN, f64::NAN, f64::NAN), |(p, _)| *p)
@@ -420,6 +488,9 @@ impl LiveRobot {
         what: &'static str,
         run: impl Fn(&Robot) -> Result<Outcome>,
     ) -> Result<()> {
+        if let Some(l) = &self.lost {
+            return Err(l.clone().into());
+        }
         if let Some(e) = &self.camera_error {
             bail!("the camera stopped: {e}");
         }

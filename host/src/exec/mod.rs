@@ -23,6 +23,7 @@ pub mod grabber;
 pub mod io;
 pub mod live;
 pub mod maneuver;
+pub mod occlusion;
 pub mod odometry_feed;
 pub mod plan_source;
 pub mod primitive;

@@ -8,9 +8,11 @@ use pushbot_world::Scene;
 
 pub use super::trials::{Method, StartResult, parse_starts, summarise};
 use crate::exec::collect::CollectReport;
+use crate::exec::deliver::Failure;
 use crate::exec::deliver::{Delivery, DeliveryParams, deliver_dipole, deliver_learned};
 use crate::exec::deliver_path::deliver_among_obstacles;
 use crate::exec::io::RobotIo;
+use crate::exec::occlusion;
 use crate::planner::global::{ObstacleParams, path_length, scene_obstacles, shortest_object_path};
 use crate::sim::robot::{SimRobot, SimRobotOptions};
 use crate::strategy::regression::{KernelParams, PushStrategy};
@@ -106,7 +108,7 @@ pub fn run_start(
             &ObstacleParams::default(),
         )
         .map(|p| path_length(&p));
-        let mut d = match method {
+        let delivered = match method {
             Method::Learned if !setup.scene.obstacles.is_empty() => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
                 deliver_among_obstacles(
@@ -117,19 +119,38 @@ pub fn run_start(
                     &setup.delivery,
                     &ObstacleParams::default(),
                     &mut |_| Ok(()),
-                )?
-                .delivery
+                )
+                .map(|d| d.delivery)
             }
             Method::Learned => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
-                deliver_learned(&mut io, &mut strat, goal, &setup.delivery, &mut |_| Ok(()))?
+                deliver_learned(&mut io, &mut strat, goal, &setup.delivery, &mut |_| Ok(()))
             }
-            Method::Dipole => deliver_dipole(&mut io, goal, &setup.delivery)?,
+            Method::Dipole => deliver_dipole(&mut io, goal, &setup.delivery),
+        };
+        // A body the camera lost ends this trial, not the evaluation: the trial failed (and
+        // whatever the delivery made of the poses it could no longer measure is void).
+        let mut d = match delivered {
+            Ok(d) if io.lost().is_none() => d,
+            Err(e) if io.lost().is_none() && !occlusion::is_lost(&e) => return Err(e),
+            _ => {
+                if let Some(l) = io.lost() {
+                    tracing::warn!("start {start}, trial {t}: {l}");
+                }
+                lost_delivery(&io, goal)
+            }
         };
         d.shortest_path = shortest;
         runs.push(d);
     }
     Ok((summarise(start, method, &runs), runs))
+}
+
+/// A trial the camera's loss of a body ended: failed, with the object's true distance from the
+/// goal where it stopped (its path is not known: what the camera saw of it is gone with it).
+fn lost_delivery(io: &SimRobot, goal: Vector2<f64>) -> Delivery {
+    let distance = (io.true_object_pose().position() - goal).norm();
+    Delivery::failed(Some(Failure::MarkerLost), io.time(), distance)
 }
 
 /// The six objects of Lau et al. (Fig. 6), as preset scenes, in the order of their Fig. 11.

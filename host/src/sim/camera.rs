@@ -24,7 +24,8 @@ use crate::vision::tracking::TrackerParams;
 const CALIBRATION_FRAMES: usize = 3;
 
 /// Most frames one look waits for a body it has not seen since the robot stopped, as the live
-/// robot does (`reacquire_frames`), before it reports the body lost.
+/// robot does (`reacquire_frames`), before the robot moves to look for it
+/// ([`crate::exec::occlusion`]).
 pub const REACQUIRE_FRAMES: usize = 30;
 
 /// The rendered camera over one simulated world and the host pipeline reading it.

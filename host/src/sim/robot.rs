@@ -16,6 +16,7 @@ use rand_distr::{Distribution, StandardNormal};
 use super::camera::{REACQUIRE_FRAMES, RenderedCamera};
 use super::inprocess::{InProcess, SimRef};
 use crate::exec::io::{Rect, RobotIo, Workspace};
+use crate::exec::occlusion::{self, BodyLost};
 use crate::link::{LinkError, Refusal};
 use crate::robot::{LinkOptions, Robot};
 use crate::strategy::sample::{Pose2, wrap_angle};
@@ -92,8 +93,12 @@ pub struct SimRobot {
     fresh: bool,
     /// Simulated time of the latest look.
     look_from: f64,
-    /// Why the camera lost a body: the next motion fails with it, as on the live robot.
+    /// Why the camera stopped: the next motion fails with it, as on the live robot.
     camera_error: Option<String>,
+    /// The body the camera lost: the next motion fails with it, as on the live robot.
+    lost: Option<BodyLost>,
+    /// Bodies seen again after the robot backed away ([`occlusion`]).
+    relooks: usize,
 }
 
 /// What a body never seen measures.
@@ -218,6 +223,8 @@ impl SimRobot {
             fresh: false,
             look_from: f64::NEG_INFINITY,
             camera_error: None,
+            lost: None,
+            relooks: 0,
         })
     }
 
@@ -251,6 +258,9 @@ impl SimRobot {
     /// Run one motion command to its `Done`; a latched fault (a stall against something that
     /// does not move) is cleared and the motion counts as ended.
     fn motion(&mut self, cmd: Command) -> Result<()> {
+        if let Some(l) = &self.lost {
+            return Err(l.clone().into());
+        }
         if let Some(e) = &self.camera_error {
             bail!("{e}");
         }
@@ -294,44 +304,142 @@ impl SimRobot {
         bail!("faults {:?} would not clear", self.sim().truth().faults)
     }
 
-    /// What the rendered camera makes of `body` now (the scene's coordinates): one look per
-    /// stop, and while `body` is not in it, one more frame at a time up to
-    /// [`REACQUIRE_FRAMES`] (the robot stands still meanwhile); still unseen, it is lost and
-    /// the next motion fails. `None` without the rendered camera or for a body never seen.
+    /// What the rendered camera makes of `body` now (the scene's coordinates). The first
+    /// query after a motion looks once, and makes sure of the robot and the object: one not in
+    /// the look is waited for, one more frame at a time up to [`REACQUIRE_FRAMES`] (the robot
+    /// stands still meanwhile; not when the robot may hide it itself); still unseen, the robot
+    /// moves away from it, looks and comes back ([`occlusion`]); still unseen, it is lost
+    /// ([`BodyLost`]) and the next motion fails. Every pose reported is from after any such
+    /// move. `None` without the rendered camera or for a body never seen.
     fn seen(&mut self, body: &str) -> Option<Pose2> {
-        let cam = self.camera.as_mut()?;
-        let driver = self.robot.driver();
-        if !self.fresh && self.camera_error.is_none() {
-            self.look_from = driver.sim().now_us() as f64 * 1e-6;
-            if let Err(e) = cam.look(&driver.sim(), &[]) {
-                self.camera_error = Some(format!("camera: {e:#}"));
+        self.camera.as_ref()?;
+        if !self.fresh && self.camera_error.is_none() && self.lost.is_none() {
+            self.look_all();
+            let object = self
+                .sim()
+                .object_poses()
+                .get(self.object)
+                .map(|(id, _)| id.clone());
+            for b in std::iter::once("robot".to_owned()).chain(object) {
+                self.make_sure_of(&b);
             }
-            self.fresh = true;
         }
-        let stale = |cam: &RenderedCamera| cam.pose(body).is_none_or(|(_, t)| t < self.look_from);
-        if self.camera_error.is_none() && stale(cam) {
-            for _ in 0..REACQUIRE_FRAMES {
-                driver.run_for(cam.period());
-                match cam.look(&driver.sim(), &[body]) {
-                    Ok(true) => break,
-                    Ok(false) => {}
-                    Err(e) => {
-                        self.camera_error = Some(format!("camera: {e:#}"));
-                        break;
-                    }
+        if self.stale(body) {
+            // Another body (a goal, another object), asked for by name.
+            self.make_sure_of(body);
+        }
+        let (p, _) = self.camera.as_ref()?.pose(body)?;
+        Some(Pose2::new(p.x - self.margin, p.y - self.margin, p.theta))
+    }
+
+    /// One look at every body, now.
+    fn look_all(&mut self) {
+        let driver = self.robot.driver();
+        let Some(cam) = self.camera.as_mut() else {
+            return;
+        };
+        self.look_from = driver.sim().now_us() as f64 * 1e-6;
+        if let Err(e) = cam.look(&driver.sim(), &[]) {
+            self.camera_error = Some(format!("camera: {e:#}"));
+        }
+        self.fresh = true;
+    }
+
+    /// Whether the camera has not seen `body` since the latest look began.
+    fn stale(&self, body: &str) -> bool {
+        self.camera
+            .as_ref()
+            .is_none_or(|c| c.pose(body).is_none_or(|(_, t)| t < self.look_from))
+    }
+
+    /// Wait for `body`, frame by frame up to [`REACQUIRE_FRAMES`]; whether it was seen.
+    fn wait_for(&mut self, body: &str) -> bool {
+        if self.camera_error.is_some() || !self.stale(body) {
+            return !self.stale(body);
+        }
+        let driver = self.robot.driver();
+        let Some(cam) = self.camera.as_mut() else {
+            return false;
+        };
+        for _ in 0..REACQUIRE_FRAMES {
+            driver.run_for(cam.period());
+            match cam.look(&driver.sim(), &[body]) {
+                Ok(true) => return true,
+                Ok(false) => {}
+                Err(e) => {
+                    self.camera_error = Some(format!("camera: {e:#}"));
+                    return false;
                 }
             }
-            if stale(cam) && self.camera_error.is_none() {
-                tracing::warn!("{body} lost");
-                self.camera_error = Some(format!(
-                    "{body} is lost: the rendered camera has not seen its marker in {} frames \
-                     since the robot stopped",
-                    REACQUIRE_FRAMES + 1
-                ));
+        }
+        false
+    }
+
+    /// Wait for `body`; unseen, back away, look again and come back ([`occlusion`]); still
+    /// unseen, it is lost.
+    fn make_sure_of(&mut self, body: &str) {
+        if self.lost.is_some() || self.camera_error.is_some() || !self.stale(body) {
+            return;
+        }
+        let last = |b: &str| self.camera.as_ref().and_then(|c| c.pose(b)).map(|(p, _)| p);
+        let robot = last("robot").map(|r| Pose2::new(r.x, r.y, r.theta));
+        let body_at = last(body).map(|b| Vector2::new(b.x, b.y));
+        // A body the robot hides does not come back by waiting.
+        if !occlusion::robot_may_hide(body, robot, body_at)
+            && (self.wait_for(body) || self.camera_error.is_some())
+        {
+            return;
+        }
+        // (A robot never seen cannot be moved with any sense: the body is lost.)
+        let moves = robot.map_or_else(Vec::new, |r| occlusion::back_offs(r, body_at).to_vec());
+        for d in moves {
+            tracing::info!("{body} not seen: the robot moves {d:+.2} m and looks again");
+            if let Err(e) = self.back_off(d) {
+                self.camera_error = Some(format!("moving to look for {body}: {e:#}"));
+                return;
+            }
+            self.look_all();
+            let seen = self.wait_for(body);
+            // Come back to where the robot stood (against the object, ready to push): the
+            // body did not move while the robot moved away from it.
+            let away = self.look_from;
+            if let Err(e) = self.back_off(-d) {
+                self.camera_error = Some(format!("coming back after looking for {body}: {e:#}"));
+                return;
+            }
+            self.look_all();
+            self.wait_for("robot");
+            if seen {
+                self.look_from = away;
+                self.relooks += 1;
+                return;
             }
         }
-        let (p, _) = cam.pose(body)?;
-        Some(Pose2::new(p.x - self.margin, p.y - self.margin, p.theta))
+        if self.camera_error.is_none() {
+            tracing::warn!("{body} lost");
+            self.lost = Some(BodyLost {
+                body: body.to_owned(),
+            });
+        }
+    }
+
+    /// One of [`occlusion::back_offs`]' moves, at [`occlusion::BACK_OFF_SPEED`].
+    fn back_off(&mut self, d: f64) -> Result<()> {
+        self.motion(Command::Move {
+            distance: d as f32,
+            speed: occlusion::BACK_OFF_SPEED as f32,
+            stop_on_contact: false,
+        })
+    }
+
+    /// The body the rendered camera lost, if it has.
+    pub fn lost(&self) -> Option<&BodyLost> {
+        self.lost.as_ref()
+    }
+
+    /// Times a body the camera did not see was seen again after the robot backed away.
+    pub fn relooks(&self) -> usize {
+        self.relooks
     }
 
     /// Frames the rendered camera has read (0 without it).
@@ -370,6 +478,25 @@ fn shift_scene(scene: &mut Scene, m: f64) {
     scene.positions.iter_mut().for_each(|p| mv(&mut p.pose));
     for o in &mut scene.obstacles {
         for v in &mut o.outline {
+            v[0] += m;
+            v[1] += m;
+        }
+    }
+    // What the camera sees at fixed places on the table moves along too (the default
+    // calibration markers follow the grown table's corners by themselves).
+    let camera = &mut scene.camera;
+    for f in camera.fiducials.iter_mut().flatten() {
+        f.x += m;
+        f.y += m;
+    }
+    for o in &mut camera.occluders {
+        for v in &mut o.outline {
+            v[0] += m;
+            v[1] += m;
+        }
+    }
+    if let Some(p) = &mut camera.pose {
+        for v in [&mut p.eye, &mut p.look_at] {
             v[0] += m;
             v[1] += m;
         }
