@@ -1,7 +1,8 @@
 //! The robot hides a marker from the overhead camera (`exec::occlusion`): with the rendered
 //! camera in the loop, a robot standing against Lau et al.'s wire cutter covers the jaws'
 //! marker, which overhangs their 2.6 cm with its own robot marker. Before the object counts
-//! as lost the robot backs away, looks, and comes back; a body that stays unseen is lost, every
+//! as lost the robot backs away, looks, and comes back (not after it only turned on the spot,
+//! which cannot move the object); a body that stays unseen is lost, every
 //! motion after fails with [`BodyLost`], and an evaluation counts the trial as failed
 //! (`marker-lost`) instead of stopping.
 
@@ -27,6 +28,9 @@ fn rendered() -> SimRobotOptions {
 /// jaws from below, facing them: the two markers' centres 5.5 cm apart.
 fn robot_against_the_jaws() -> Scene {
     let mut scene = Scene::preset("lau-wire-cutter").unwrap();
+    // A robot with its marker in its middle (the lau presets put it at the rear, where it
+    // hides this marker only from other poses).
+    scene.camera.robot_marker.x = 0.0;
     scene.robot.start = pushbot_world::Pose::new(0.48, 0.95 - 0.0135 - 0.04 - 0.0015, FRAC_PI_2);
     scene
 }
@@ -62,6 +66,15 @@ fn a_robot_that_hides_the_object_backs_away_looks_and_comes_back() {
     );
     // It went BACK_OFF away and back: 2 × BACK_OFF of driving, at the robot's speed.
     assert!(r.time() > 2.0 * BACK_OFF / SimRobotOptions::default().speed);
+    // Turning on the spot presses on nothing: the object, hidden again, did not move, and the
+    // robot does not move to look for it (its last pose stands).
+    let before = r.true_object_pose();
+    r.spin(0.5).unwrap();
+    let kept = r.object_pose();
+    assert_eq!(r.relooks(), 1, "the robot moved to look after only turning");
+    assert_eq!(kept, object, "the object's pose was measured again");
+    assert!((r.true_object_pose().position() - before.position()).norm() < 1e-3);
+    assert!((r.true_robot_pose().position() - end.position()).norm() < 0.005);
     // The next look needs no backing away when the robot stands off the object.
     r.forward(-0.1).unwrap();
     r.object_pose();

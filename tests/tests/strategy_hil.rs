@@ -105,8 +105,11 @@ fn a_delivery_through_a_distorting_lens_with_raised_markers_reaches_the_goal() {
             "marker = { id = 1, x = 0, y = 0, size = 0.05 }",
             "marker = { id = 1, x = 0, y = 0, size = 0.05, z = 0.03 }",
         )
-        + "\n[camera]\nintrinsics = \"webcam.yaml\"\n\
-           robot_marker = { id = 0, x = 0.0, y = 0.0, size = 0.05, z = 0.06 }\n";
+        .replace("[camera]\n", "[camera]\nintrinsics = \"webcam.yaml\"\n")
+        .replace(
+            "robot_marker = { id = 0, x = -0.03, y = 0.0, size = 0.05 }",
+            "robot_marker = { id = 0, x = -0.03, y = 0.0, size = 0.05, z = 0.06 }",
+        );
     let path = dir.path().join("irregular-real.toml");
     std::fs::write(&path, text).expect("write the scene");
     let scene = Scene::load(&path).expect("the scene loads");
@@ -118,6 +121,10 @@ fn a_delivery_through_a_distorting_lens_with_raised_markers_reaches_the_goal() {
         scene.objects[0].marker.map(|m| m.z),
         Some(0.03),
         "the object's marker is raised"
+    );
+    assert_eq!(
+        scene.camera.robot_marker.z, 0.06,
+        "the robot's marker is raised"
     );
     assert!((scene.objects[0].pose.y - 0.25).abs() < 1e-9, "start C");
     let goal = scene.goals[0].pose;

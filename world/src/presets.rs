@@ -195,6 +195,11 @@ pose = {{ x = 0.85, y = 0.25, theta = 0.7854 }}
 [[positions]]
 name = "F"
 pose = {{ x = 1.3, y = 0.95, theta = 2.3562 }}
+
+# The robot's marker sits 3 cm behind its middle, out of the way of what it pushes: in the
+# middle it covers a thin object's marker whenever the robot stands against it.
+[camera]
+robot_marker = {{ id = 0, x = -0.03, y = 0.0, size = 0.05 }}
 "#
     )
 }

@@ -17,7 +17,9 @@ use pushbot_protocol::Outcome;
 use pushbot_world::Scene;
 
 use super::grabber::FrameGrabber;
-use super::occlusion::{self, BodyLost};
+use super::occlusion;
+
+mod look;
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::link::LinkError;
 use crate::robot::{LinkOptions, Recovery, Robot, link_broke};
@@ -74,6 +76,9 @@ pub struct LiveOptions {
     /// Frames to wait for the robot or the object to be seen again when a look did not see it
     /// (a hand over the table, a smeared marker), before the task stops with "lost".
     pub reacquire_frames: usize,
+    /// Speed of the robot's moves away from a body it hides and back ([`occlusion`]), m/s:
+    /// nothing is pushed on them, so faster than `speed` (within the firmware's limit).
+    pub look_again_speed: f64,
 }
 
 impl Default for LiveOptions {
@@ -95,6 +100,7 @@ impl Default for LiveOptions {
             lens: None,
             recording: None,
             reacquire_frames: 150,
+            look_again_speed: occlusion::BACK_OFF_SPEED,
         }
     }
 }
@@ -117,10 +123,8 @@ pub struct LiveRobot {
     look_from: f64,
     /// Why the camera stopped, once it has: the next primitive fails with it.
     camera_error: Option<String>,
-    /// The body the camera lost, once it has: the next primitive fails with it.
-    lost: Option<BodyLost>,
-    /// Bodies seen again after the robot backed away ([`occlusion`]).
-    relooks: usize,
+    /// The look-again rule's state: relooks, the body lost ([`occlusion::Sight`]).
+    sight: occlusion::Sight,
     t0_us: u64,
     /// Wall instant and robot clock (s) when the robot last went idle (end of a primitive).
     idle_since: (std::time::Instant, f64),
@@ -148,6 +152,14 @@ impl LiveRobot {
     /// Connect to the robot on `port` and the camera `camera` (as `--camera` spells it) over
     /// the table of `scene`; calibrate unless `opts` brings a calibration; look once.
     pub fn connect(port: &str, camera: &str, scene: &Scene, opts: LiveOptions) -> Result<Self> {
+        for (what, v) in [
+            ("speed", opts.speed),
+            ("look-again speed", opts.look_again_speed),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("the {what} must be a positive number of m/s, not {v}");
+            }
+        }
         let object = match &opts.object {
             Some(id) => Some(
                 scene
@@ -240,8 +252,10 @@ impl LiveRobot {
             fresh: false,
             look_from: f64::NEG_INFINITY,
             camera_error: None,
-            lost: None,
-            relooks: 0,
+            sight: occlusion::Sight::new(
+                scene.robot.front_plate.is_none(),
+                [scene.camera.robot_marker.x, scene.camera.robot_marker.y],
+            ),
             t0_us,
             idle_since: (std::time::Instant::now(), 0.0),
             host_adjust: 0.0,
@@ -252,7 +266,7 @@ impl LiveRobot {
             opts,
         };
         live.look()?;
-        live.reacquire("robot");
+        live.wait_for("robot")?;
         if !live.poses.contains_key("robot") {
             bail!(
                 "the camera does not see the robot's marker (tag {}) in {} frames",
@@ -290,7 +304,7 @@ impl LiveRobot {
 
     /// Times a body the camera did not see was seen again after the robot backed away.
     pub fn relooks(&self) -> usize {
-        self.relooks
+        self.sight.relooks
     }
 
     /// The latest pose of a tracked body (`robot`, an object id or `goal:<object id>`), with
@@ -307,178 +321,6 @@ impl LiveRobot {
             .map_or(0.0, |t| t.time_us.saturating_sub(self.t0_us) as f64 * 1e-6)
     }
 
-    /// Look now: process fresh frames (taken after this call) and update every body's pose.
-    pub fn look(&mut self) -> Result<()> {
-        let (wall, t0) = (std::time::Instant::now(), self.robot_clock());
-        // The frame being rendered or exposed right now may show the past: skip it.
-        let mut after = self.grabber.count() + 1;
-        for k in 0..self.opts.frames_per_look.max(1) {
-            let time;
-            (after, time) = self.process_next(after)?;
-            if k == 0 {
-                self.look_from = time;
-            }
-        }
-        self.fresh = true;
-        tracing::debug!(
-            "look: {:.0} ms wall, {:.2} s robot time",
-            wall.elapsed().as_secs_f64() * 1e3,
-            self.robot_clock() - t0
-        );
-        Ok(())
-    }
-
-    /// Process the first frame after frame number `after`; its number and time.
-    fn process_next(&mut self, after: u64) -> Result<(u64, f64)> {
-        let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
-        // The robot stands still while the host looks: its odometry now is its odometry when
-        // the frame was taken, and the tracker predicts the primitive's motion from it.
-        let odometry = self.robot.telemetry().map(|t| {
-            let p = t.pose;
-            [f64::from(p.x), f64::from(p.y), f64::from(p.theta)]
-        });
-        if let Some([x, y, theta]) = odometry {
-            self.pipeline.odometry(
-                "robot",
-                frame.time,
-                crate::vision::layout::Pose::new(x, y, theta),
-            );
-        }
-        let r = self.pipeline.process(&frame)?;
-        self.frames_seen += 1;
-        if let Some(v) = self.view.as_mut()
-            && let Err(e) = v.update(&frame, &r, self.pipeline.calibration())
-        {
-            tracing::warn!("live view: {e:#}");
-        }
-        if let Some(rec) = &self.recording {
-            rec.look(
-                &self.robot,
-                &frame,
-                &r,
-                self.pipeline.calibration(),
-                odometry,
-            );
-        }
-        for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
-            let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
-            self.poses.insert(t.body.clone(), (p, t.time));
-        }
-        Ok((n, frame.time))
-    }
-
-    /// Whether the camera has seen `body` since the latest look began.
-    fn seen_since_look(&self, body: &str) -> bool {
-        self.poses
-            .get(body)
-            .is_some_and(|(_, t)| *t >= self.look_from)
-    }
-
-    /// The robot stands still between primitives: a body the latest look did not see is
-    /// waited for, frame by frame, up to `reacquire_frames`; whether it was seen.
-    fn reacquire(&mut self, body: &str) -> bool {
-        if self.camera_error.is_some() || self.seen_since_look(body) {
-            return self.seen_since_look(body);
-        }
-        let mut after = self.grabber.count();
-        for k in 0..self.opts.reacquire_frames {
-            match self.process_next(after) {
-                Ok((n, _)) => after = n,
-                Err(e) => {
-                    self.camera_error = Some(format!("{e:#}"));
-                    return false;
-                }
-            }
-            if self.seen_since_look(body) {
-                tracing::info!("{body} seen again after {} frame(s)", k + 1);
-                return true;
-            }
-        }
-        false
-    }
-
-    /// Wait for `body`; unseen, the robot backs away ([`occlusion`]: it may hide the body
-    /// itself), looks again and comes back; still unseen, it is lost and the task stops (the
-    /// next primitive fails with it) rather than act on an old pose.
-    fn make_sure_of(&mut self, body: &str) {
-        if self.lost.is_some() || self.camera_error.is_some() || self.seen_since_look(body) {
-            return;
-        }
-        let robot = self.poses.get("robot").map(|(p, _)| *p);
-        let body_at = self.poses.get(body).map(|(p, _)| p.position());
-        // A body the robot hides does not come back by waiting.
-        if !occlusion::robot_may_hide(body, robot, body_at)
-            && (self.reacquire(body) || self.camera_error.is_some())
-        {
-            return;
-        }
-        // (A robot never seen cannot be moved with any sense: the body is lost.)
-        let moves = robot.map_or_else(Vec::new, |r| occlusion::back_offs(r, body_at).to_vec());
-        for d in moves {
-            tracing::info!("{body} not seen: the robot moves {d:+.2} m and looks again");
-            let seen = self
-                .back_off(d)
-                .and_then(|()| self.look())
-                .map(|()| self.reacquire(body));
-            // Come back to where the robot stood: the body did not move meanwhile.
-            let away = self.look_from;
-            let back = self.back_off(-d).and_then(|()| self.look());
-            match (seen, back) {
-                (Ok(seen), Ok(())) => {
-                    self.reacquire("robot");
-                    if seen {
-                        self.look_from = away;
-                        self.relooks += 1;
-                        return;
-                    }
-                }
-                (Err(e), _) | (_, Err(e)) => {
-                    self.camera_error = Some(format!("moving to look for {body}: {e:#}"));
-                    return;
-                }
-            }
-        }
-        tracing::warn!("{body} lost");
-        self.lost = Some(BodyLost {
-            body: body.to_owned(),
-        });
-    }
-
-    /// One of [`occlusion::back_offs`]' moves, at [`occlusion::BACK_OFF_SPEED`].
-    fn back_off(&mut self, d: f64) -> Result<()> {
-        let speed = occlusion::BACK_OFF_SPEED as f32;
-        self.motion("move", |r| {
-            Ok(r.move_distance(d as f32, speed, false)?.outcome)
-        })
-    }
-
-    /// Look once after a motion, and make sure of the robot and the object: every pose
-    /// reported is from after any backing away.
-    fn look_if_stale(&mut self) {
-        if self.fresh || self.camera_error.is_some() || self.lost.is_some() {
-            return;
-        }
-        if let Err(e) = self.look() {
-            tracing::warn!("camera: {e:#}");
-            self.camera_error = Some(format!("{e:#}"));
-            return;
-        }
-        self.make_sure_of("robot");
-        if let Some(object) = self.object.clone() {
-            self.make_sure_of(&object);
-        }
-    }
-
-    fn pose_of(&mut self, body: &str) -> Pose2 {
-        self.look_if_stale();
-        if !self.seen_since_look(body) {
-            self.make_sure_of(body);
-        }
-        self.poses
-            .get(body)
-            .map_or(Pose2::new(f64::NAN, f64::NAN, f64::NAN), |(p, _)| *p)
-    }
-
     /// Run one motion to its end; a fault it ended in (a stall against something that does not
     /// move) is cleared and the motion counts as ended, as the strategy expects. A broken link
     /// is recovered ([`Robot::recover`]) and the motion counts as ended too: the executor looks
@@ -488,13 +330,14 @@ impl LiveRobot {
         what: &'static str,
         run: impl Fn(&Robot) -> Result<Outcome>,
     ) -> Result<()> {
-        if let Some(l) = &self.lost {
+        if let Some(l) = &self.sight.lost {
             return Err(l.clone().into());
         }
         if let Some(e) = &self.camera_error {
             bail!("the camera stopped: {e}");
         }
         self.fresh = false;
+        self.sight.since.motion(what == "spin");
         let (wall, t0) = (std::time::Instant::now(), self.robot_clock());
         let (idle_wall, idle_robot) = self.idle_since;
         self.host_adjust += idle_wall.elapsed().as_secs_f64() - (t0 - idle_robot);

@@ -16,7 +16,7 @@ use rand_distr::{Distribution, StandardNormal};
 use super::camera::{REACQUIRE_FRAMES, RenderedCamera};
 use super::inprocess::{InProcess, SimRef};
 use crate::exec::io::{Rect, RobotIo, Workspace};
-use crate::exec::occlusion::{self, BodyLost};
+use crate::exec::occlusion::{self, BodyLost, Looking};
 use crate::link::{LinkError, Refusal};
 use crate::robot::{LinkOptions, Robot};
 use crate::strategy::sample::{Pose2, wrap_angle};
@@ -84,6 +84,8 @@ pub struct SimRobot {
     opts: SimRobotOptions,
     rng: ChaCha8Rng,
     object: usize,
+    /// The object's id (what the camera calls it).
+    object_id: String,
     marker: [f64; 2],
     workspace: Workspace,
     margin: f64,
@@ -95,10 +97,8 @@ pub struct SimRobot {
     look_from: f64,
     /// Why the camera stopped: the next motion fails with it, as on the live robot.
     camera_error: Option<String>,
-    /// The body the camera lost: the next motion fails with it, as on the live robot.
-    lost: Option<BodyLost>,
-    /// Bodies seen again after the robot backed away ([`occlusion`]).
-    relooks: usize,
+    /// The look-again rule's state: relooks, the body lost ([`occlusion::Sight`]).
+    sight: occlusion::Sight,
 }
 
 /// What a body never seen measures.
@@ -152,6 +152,10 @@ impl SimRobot {
             scene.objects[object].pose = pose;
         }
         let obj = &scene.objects[object];
+        let object_id = obj.id.clone();
+        // A round robot (no front plate) presses on nothing as it turns on the spot.
+        let scene_round = scene.robot.front_plate.is_none();
+        let robot_marker = [scene.camera.robot_marker.x, scene.camera.robot_marker.y];
         let marker = obj.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
         let object_radius = obj
             .outline
@@ -216,6 +220,7 @@ impl SimRobot {
             opts,
             rng,
             object,
+            object_id,
             marker,
             workspace,
             margin: m,
@@ -223,8 +228,7 @@ impl SimRobot {
             fresh: false,
             look_from: f64::NEG_INFINITY,
             camera_error: None,
-            lost: None,
-            relooks: 0,
+            sight: occlusion::Sight::new(scene_round, robot_marker),
         })
     }
 
@@ -258,13 +262,14 @@ impl SimRobot {
     /// Run one motion command to its `Done`; a latched fault (a stall against something that
     /// does not move) is cleared and the motion counts as ended.
     fn motion(&mut self, cmd: Command) -> Result<()> {
-        if let Some(l) = &self.lost {
+        if let Some(l) = &self.sight.lost {
             return Err(l.clone().into());
         }
         if let Some(e) = &self.camera_error {
             bail!("{e}");
         }
         self.fresh = false;
+        self.sight.since.motion(matches!(cmd, Command::Spin { .. }));
         for attempt in 0..2 {
             let started = match self.robot.start(cmd) {
                 Ok(m) => m,
@@ -313,16 +318,11 @@ impl SimRobot {
     /// move. `None` without the rendered camera or for a body never seen.
     fn seen(&mut self, body: &str) -> Option<Pose2> {
         self.camera.as_ref()?;
-        if !self.fresh && self.camera_error.is_none() && self.lost.is_none() {
+        if !self.fresh && self.camera_error.is_none() && self.sight.lost.is_none() {
             self.look_all();
-            let object = self
-                .sim()
-                .object_poses()
-                .get(self.object)
-                .map(|(id, _)| id.clone());
-            for b in std::iter::once("robot".to_owned()).chain(object) {
-                self.make_sure_of(&b);
-            }
+            self.make_sure_of("robot");
+            let object = self.object_id.clone();
+            self.make_sure_of(&object);
         }
         if self.stale(body) {
             // Another body (a goal, another object), asked for by name.
@@ -334,13 +334,8 @@ impl SimRobot {
 
     /// One look at every body, now.
     fn look_all(&mut self) {
-        let driver = self.robot.driver();
-        let Some(cam) = self.camera.as_mut() else {
-            return;
-        };
-        self.look_from = driver.sim().now_us() as f64 * 1e-6;
-        if let Err(e) = cam.look(&driver.sim(), &[]) {
-            self.camera_error = Some(format!("camera: {e:#}"));
+        if let Err(e) = Looker(self).look() {
+            self.camera_error = Some(format!("{e:#}"));
         }
         self.fresh = true;
     }
@@ -352,94 +347,26 @@ impl SimRobot {
             .is_none_or(|c| c.pose(body).is_none_or(|(_, t)| t < self.look_from))
     }
 
-    /// Wait for `body`, frame by frame up to [`REACQUIRE_FRAMES`]; whether it was seen.
-    fn wait_for(&mut self, body: &str) -> bool {
-        if self.camera_error.is_some() || !self.stale(body) {
-            return !self.stale(body);
-        }
-        let driver = self.robot.driver();
-        let Some(cam) = self.camera.as_mut() else {
-            return false;
-        };
-        for _ in 0..REACQUIRE_FRAMES {
-            driver.run_for(cam.period());
-            match cam.look(&driver.sim(), &[body]) {
-                Ok(true) => return true,
-                Ok(false) => {}
-                Err(e) => {
-                    self.camera_error = Some(format!("camera: {e:#}"));
-                    return false;
-                }
-            }
-        }
-        false
-    }
-
     /// Wait for `body`; unseen, back away, look again and come back ([`occlusion`]); still
     /// unseen, it is lost.
     fn make_sure_of(&mut self, body: &str) {
-        if self.lost.is_some() || self.camera_error.is_some() || !self.stale(body) {
+        if self.sight.lost.is_some() || self.camera_error.is_some() || self.camera.is_none() {
             return;
         }
-        let last = |b: &str| self.camera.as_ref().and_then(|c| c.pose(b)).map(|(p, _)| p);
-        let robot = last("robot").map(|r| Pose2::new(r.x, r.y, r.theta));
-        let body_at = last(body).map(|b| Vector2::new(b.x, b.y));
-        // A body the robot hides does not come back by waiting.
-        if !occlusion::robot_may_hide(body, robot, body_at)
-            && (self.wait_for(body) || self.camera_error.is_some())
-        {
-            return;
+        match occlusion::make_sure_of(&mut Looker(self), body) {
+            Ok(sure) => self.sight.record(sure),
+            Err(e) => self.camera_error = Some(format!("looking for {body}: {e:#}")),
         }
-        // (A robot never seen cannot be moved with any sense: the body is lost.)
-        let moves = robot.map_or_else(Vec::new, |r| occlusion::back_offs(r, body_at).to_vec());
-        for d in moves {
-            tracing::info!("{body} not seen: the robot moves {d:+.2} m and looks again");
-            if let Err(e) = self.back_off(d) {
-                self.camera_error = Some(format!("moving to look for {body}: {e:#}"));
-                return;
-            }
-            self.look_all();
-            let seen = self.wait_for(body);
-            // Come back to where the robot stood (against the object, ready to push): the
-            // body did not move while the robot moved away from it.
-            let away = self.look_from;
-            if let Err(e) = self.back_off(-d) {
-                self.camera_error = Some(format!("coming back after looking for {body}: {e:#}"));
-                return;
-            }
-            self.look_all();
-            self.wait_for("robot");
-            if seen {
-                self.look_from = away;
-                self.relooks += 1;
-                return;
-            }
-        }
-        if self.camera_error.is_none() {
-            tracing::warn!("{body} lost");
-            self.lost = Some(BodyLost {
-                body: body.to_owned(),
-            });
-        }
-    }
-
-    /// One of [`occlusion::back_offs`]' moves, at [`occlusion::BACK_OFF_SPEED`].
-    fn back_off(&mut self, d: f64) -> Result<()> {
-        self.motion(Command::Move {
-            distance: d as f32,
-            speed: occlusion::BACK_OFF_SPEED as f32,
-            stop_on_contact: false,
-        })
     }
 
     /// The body the rendered camera lost, if it has.
     pub fn lost(&self) -> Option<&BodyLost> {
-        self.lost.as_ref()
+        self.sight.lost.as_ref()
     }
 
     /// Times a body the camera did not see was seen again after the robot backed away.
     pub fn relooks(&self) -> usize {
-        self.relooks
+        self.sight.relooks
     }
 
     /// Frames the rendered camera has read (0 without it).
@@ -461,6 +388,63 @@ impl SimRobot {
             p.y + self.opts.position_noise * b,
             wrap_angle(p.theta + self.opts.heading_noise * c),
         )
+    }
+}
+
+/// The simulated robot as [`occlusion`] sees it: looks with the rendered camera, waits in
+/// simulated time, and moves at [`occlusion::BACK_OFF_SPEED`].
+struct Looker<'a>(&'a mut SimRobot);
+
+impl occlusion::Looking for Looker<'_> {
+    fn last_seen(&self, body: &str) -> Option<Pose2> {
+        let (p, _) = self.0.camera.as_ref()?.pose(body)?;
+        Some(Pose2::new(p.x, p.y, p.theta))
+    }
+
+    fn seen_since_look(&self, body: &str) -> bool {
+        !self.0.stale(body)
+    }
+
+    fn look(&mut self) -> Result<f64> {
+        let driver = self.0.robot.driver();
+        let cam = self.0.camera.as_mut().context("no rendered camera")?;
+        let t = driver.sim().now_us() as f64 * 1e-6;
+        cam.look(&driver.sim(), &[]).context("camera")?;
+        self.0.look_from = t;
+        self.0.fresh = true;
+        Ok(t)
+    }
+
+    fn look_from(&mut self, t: f64) {
+        self.0.look_from = t;
+    }
+
+    /// Frame by frame up to [`REACQUIRE_FRAMES`], the simulation running between them.
+    fn wait_for(&mut self, body: &str, frames: Option<usize>) -> Result<bool> {
+        if !self.0.stale(body) {
+            return Ok(true);
+        }
+        let driver = self.0.robot.driver();
+        let cam = self.0.camera.as_mut().context("no rendered camera")?;
+        for _ in 0..frames.unwrap_or(REACQUIRE_FRAMES) {
+            driver.run_for(cam.period());
+            if cam.look(&driver.sim(), &[body]).context("camera")? {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    fn sight(&mut self) -> &mut occlusion::Sight {
+        &mut self.0.sight
+    }
+
+    fn straight(&mut self, d: f64) -> Result<()> {
+        self.0.motion(Command::Move {
+            distance: d as f32,
+            speed: occlusion::BACK_OFF_SPEED as f32,
+            stop_on_contact: false,
+        })
     }
 }
 
@@ -545,12 +529,8 @@ impl RobotIo for SimRobot {
 
     fn object_pose(&mut self) -> Pose2 {
         if self.camera.is_some() {
-            let id = self
-                .sim()
-                .object_poses()
-                .get(self.object)
-                .map(|(id, _)| id.clone());
-            let Some(body) = id.and_then(|id| self.seen(&id)) else {
+            let id = self.object_id.clone();
+            let Some(body) = self.seen(&id) else {
                 return NAN_POSE;
             };
             let m = body.point_to_world(Vector2::new(self.marker[0], self.marker[1]));

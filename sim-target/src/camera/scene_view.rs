@@ -243,8 +243,12 @@ mod tests {
         assert!(frame.truth.iter().all(|t| t.fully_visible));
         let ids: Vec<u32> = frame.truth.iter().map(|t| t.marker.id).collect();
         assert!(ids.contains(&0) && ids.contains(&1) && ids.contains(&20));
-        // The robot's marker is where the robot is.
+        // The robot's marker is where it sits on the robot (3 cm behind its middle; the robot
+        // faces +x).
         let robot = frame.truth.last().expect("robot marker");
-        assert!((robot.marker.centre[0] - scene.robot.start.x).abs() < 1e-12);
+        let rm = &scene.camera.robot_marker;
+        assert!(rm.x < 0.0);
+        assert!((robot.marker.centre[0] - (scene.robot.start.x + rm.x)).abs() < 1e-12);
+        assert!((robot.marker.centre[1] - scene.robot.start.y).abs() < 1e-12);
     }
 }
