@@ -20,6 +20,7 @@ pub mod collect;
 pub mod deliver;
 pub mod deliver_path;
 pub mod grabber;
+pub mod grid_snap;
 pub mod io;
 pub mod live;
 pub mod maneuver;
