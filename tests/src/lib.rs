@@ -104,8 +104,13 @@ pub fn bin(name: &str) -> std::path::PathBuf {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let mut cmd = std::process::Command::new(cargo);
         cmd.args(["build", "--quiet", "-p", package, "--bin", name]);
+        // target/release holds `cargo test --release`'s build; target/debug `cargo test`'s,
+        // whose profile is `test` (not `dev`): its libraries are already built, so only the
+        // binary links.
         if dir.file_name().is_some_and(|p| p == "release") {
             cmd.arg("--release");
+        } else {
+            cmd.args(["--profile", "test"]);
         }
         // Build where the test was built.
         if let Some(target) = dir.parent() {

@@ -325,11 +325,7 @@ impl LiveRobot {
     /// move) is cleared and the motion counts as ended, as the strategy expects. A broken link
     /// is recovered ([`Robot::recover`]) and the motion counts as ended too: the executor looks
     /// again and goes on from where the robot really is.
-    fn motion(
-        &mut self,
-        what: &'static str,
-        run: impl Fn(&Robot) -> Result<Outcome>,
-    ) -> Result<()> {
+    fn motion(&mut self, what: Motion, run: impl Fn(&Robot) -> Result<Outcome>) -> Result<()> {
         if let Some(l) = &self.sight.lost {
             return Err(l.clone().into());
         }
@@ -337,7 +333,7 @@ impl LiveRobot {
             bail!("the camera stopped: {e}");
         }
         self.fresh = false;
-        self.sight.since.motion(what == "spin");
+        self.sight.since.motion(what == Motion::Spin);
         let (wall, t0) = (std::time::Instant::now(), self.robot_clock());
         let (idle_wall, idle_robot) = self.idle_since;
         self.host_adjust += idle_wall.elapsed().as_secs_f64() - (t0 - idle_robot);
@@ -352,11 +348,7 @@ impl LiveRobot {
         out
     }
 
-    fn run_motion(
-        &mut self,
-        what: &'static str,
-        run: impl Fn(&Robot) -> Result<Outcome>,
-    ) -> Result<()> {
+    fn run_motion(&mut self, what: Motion, run: impl Fn(&Robot) -> Result<Outcome>) -> Result<()> {
         // A refused command never started: clear the faults and send it again, a few times (a
         // loaded host can let the link watchdog fire again between the clear and the retry).
         const ATTEMPTS: usize = 4;
@@ -401,7 +393,7 @@ impl LiveRobot {
     }
 
     /// The link broke during `what`: recover it, or say why not.
-    fn recover_link(&mut self, what: &'static str, cause: String) -> Result<()> {
+    fn recover_link(&mut self, what: Motion, cause: String) -> Result<()> {
         /// Recoveries in a row (no motion ending in between) before giving up.
         const MOST_IN_A_ROW: usize = 5;
         if !self.opts.recover {
@@ -412,13 +404,8 @@ impl LiveRobot {
         }
         self.recoveries_in_a_row += 1;
         let seq = self.robot.last_seq();
-        let command = match what {
-            "spin" => "Spin",
-            "move" => "Move",
-            _ => "Velocity",
-        };
         self.robot
-            .recover(&cause, Some((seq, command)))
+            .recover(&cause, Some((seq, what.command())))
             .with_context(|| format!("recovering the link after: {cause}"))?;
         // A robot that restarted counts its odometry from zero again.
         self.pipeline.forget_odometry("robot");
@@ -474,6 +461,36 @@ fn calibrate(
     Calibration::fit_through(&frames, layout, size, lens.as_ref()).context("calibrating the camera")
 }
 
+/// The kinds of motion the live robot is sent: a spin on the spot, a straight move, a velocity
+/// command for a time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Motion {
+    Spin,
+    Move,
+    Velocity,
+}
+
+impl Motion {
+    /// The protocol command's name, as [`Robot::recover`] reports it.
+    fn command(self) -> &'static str {
+        match self {
+            Motion::Spin => "Spin",
+            Motion::Move => "Move",
+            Motion::Velocity => "Velocity",
+        }
+    }
+}
+
+impl std::fmt::Display for Motion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Motion::Spin => "spin",
+            Motion::Move => "move",
+            Motion::Velocity => "velocity",
+        })
+    }
+}
+
 impl RobotIo for LiveRobot {
     fn spin(&mut self, angle: f64) -> Result<()> {
         let angle = crate::strategy::sample::wrap_angle(angle);
@@ -481,7 +498,7 @@ impl RobotIo for LiveRobot {
             return Ok(());
         }
         let rate = self.opts.spin_rate as f32;
-        self.motion("spin", |r| Ok(r.spin(angle as f32, rate)?.outcome))
+        self.motion(Motion::Spin, |r| Ok(r.spin(angle as f32, rate)?.outcome))
     }
 
     fn forward(&mut self, distance: f64) -> Result<()> {
@@ -490,13 +507,15 @@ impl RobotIo for LiveRobot {
         }
         let speed = self.opts.speed as f32;
         let d = distance.clamp(-2.0, 2.0) as f32;
-        self.motion("move", |r| Ok(r.move_distance(d, speed, false)?.outcome))
+        self.motion(Motion::Move, |r| {
+            Ok(r.move_distance(d, speed, false)?.outcome)
+        })
     }
 
     fn drive(&mut self, v: f64, omega: f64, duration: f64) -> Result<()> {
         let ms = (duration * 1e3).clamp(1.0, 60_000.0) as u64;
         let (v, omega) = (v.clamp(-0.3, 0.3) as f32, omega.clamp(-4.0, 4.0) as f32);
-        self.motion("velocity", |r| {
+        self.motion(Motion::Velocity, |r| {
             let m = r.velocity(v, omega, Duration::from_millis(ms))?;
             Ok(r.wait(&m)?.outcome)
         })

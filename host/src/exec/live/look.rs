@@ -166,7 +166,7 @@ impl Looking for Looker<'_> {
 
     fn straight(&mut self, d: f64) -> Result<()> {
         let speed = self.0.opts.look_again_speed as f32;
-        self.0.motion("move", |r| {
+        self.0.motion(super::Motion::Move, |r| {
             Ok(r.move_distance(d as f32, speed, false)?.outcome)
         })
     }
