@@ -79,10 +79,13 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
 ///
 /// `cargo test -p pushbot-tests` builds this package's dependencies as libraries only, so the
 /// binaries are built here (once per test process) with the cargo that runs the tests, into
-/// the same target directory and profile as the test itself.
+/// the same target directory and profile as the test itself. Both are built by one
+/// `cargo build --workspace --bins`: its features resolve as `cargo test --workspace`'s do, so
+/// the libraries that build has made are reused and only the binaries link (a build of one
+/// package alone resolves its dependencies' features anew and compiles them all again).
 pub fn bin(name: &str) -> std::path::PathBuf {
-    use std::sync::{Mutex, OnceLock};
-    static BUILT: OnceLock<Mutex<Vec<String>>> = OnceLock::new();
+    use std::sync::Mutex;
+    static BUILT: Mutex<bool> = Mutex::new(false);
     let exe = std::env::current_exe().expect("the test's own path");
     // target/<profile>/deps/<test>-<hash>
     let dir = exe
@@ -90,23 +93,18 @@ pub fn bin(name: &str) -> std::path::PathBuf {
         .and_then(|d| d.parent())
         .expect("the test runs from target/<profile>/deps")
         .to_path_buf();
+    assert!(
+        matches!(name, "pushbot" | "pushbot-sim"),
+        "no binary {name} in this workspace"
+    );
     let path = dir.join(name);
-    let package = match name {
-        "pushbot" => "pushbot",
-        "pushbot-sim" => "pushbot-sim",
-        other => panic!("no binary {other} in this workspace"),
-    };
-    let mut built = BUILT
-        .get_or_init(|| Mutex::new(Vec::new()))
-        .lock()
-        .unwrap_or_else(|e| e.into_inner());
-    if !built.iter().any(|b| b == name) {
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    if !*built {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let mut cmd = std::process::Command::new(cargo);
-        cmd.args(["build", "--quiet", "-p", package, "--bin", name]);
+        cmd.args(["build", "--quiet", "--workspace", "--bins"]);
         // target/release holds `cargo test --release`'s build; target/debug `cargo test`'s,
-        // whose profile is `test` (not `dev`): its libraries are already built, so only the
-        // binary links.
+        // whose profile is `test` (not `dev`).
         if dir.file_name().is_some_and(|p| p == "release") {
             cmd.arg("--release");
         } else {
@@ -120,11 +118,8 @@ pub fn bin(name: &str) -> std::path::PathBuf {
             .current_dir(env!("CARGO_MANIFEST_DIR"))
             .status()
             .expect("run cargo build");
-        assert!(
-            status.success(),
-            "cargo build -p {package} --bin {name} failed"
-        );
-        built.push(name.to_owned());
+        assert!(status.success(), "cargo build --workspace --bins failed");
+        *built = true;
     }
     assert!(path.exists(), "{} was not built", path.display());
     path
