@@ -18,11 +18,11 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use crate::exec::io::{Rect, RobotIo, Workspace};
-use crate::exec::maneuver::{Drive, Turn, angle_of, around_object, circle_walk, face, go_to};
-use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
+use crate::exec::maneuver::{Drive, Turn, angle_of, circle_walk, face, go_to};
+use crate::exec::reposition::reachable_reposition;
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
-use crate::strategy::regression::{PushStrategy, Reposition};
+use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::{Pose2, Sample, wrap_angle};
 
 /// Parameters of delivery.
@@ -323,58 +323,6 @@ pub fn deliver_learned(
     deliver_learned_among(io, strategy, goal, p, &[], None, sink)
 }
 
-/// Wanted directions tried, in order, when the robot cannot stand where the special case puts
-/// it: the direction to the goal, then turned either way by up to 90°.
-const SPECIAL_TURNS_DEG: [f64; 13] = [
-    0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 60.0, -60.0, 75.0, -75.0, 90.0, -90.0,
-];
-
-/// The special case's re-positioning (Algorithm 2) for an object at `o` wanted to move along
-/// `want` (object frame), where the robot can stand and get to: the stand point and its
-/// approach point on the bound-all circle must be clear of the table's edge and of
-/// `obstacles`, and a path must lead from the robot at `from` to the approach point around the
-/// obstacles and the object. When they are not, the wanted direction is turned a little either
-/// way ([`SPECIAL_TURNS_DEG`]); the first direction that works wins, else the untouched one.
-fn reachable_reposition(
-    strategy: &PushStrategy,
-    ws: &Workspace,
-    obstacles: &[Vec<[f64; 2]>],
-    o: &Pose2,
-    from: Vector2<f64>,
-    want: [f64; 2],
-    bound_all: f64,
-) -> Option<Reposition> {
-    let first = strategy.special(want)?;
-    if obstacles.is_empty() {
-        return Some(first);
-    }
-    let around = around_object(ws, obstacles, o.position(), bound_all);
-    let clear = |rep: &Reposition| {
-        let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
-        let rel = at - o.position();
-        let approach = if rel.norm() > 1e-9 {
-            o.position() + bound_all * rel.normalize()
-        } else {
-            at
-        };
-        robot_fits(ws, obstacles, at)
-            && robot_fits(ws, obstacles, approach)
-            && (segment_clear(ws, &around, from, approach)
-                || plan_robot_path(ws, &around, from, approach).is_some())
-    };
-    if clear(&first) {
-        return Some(first);
-    }
-    SPECIAL_TURNS_DEG[1..]
-        .iter()
-        .filter_map(|deg| {
-            let (s, c) = deg.to_radians().sin_cos();
-            strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])
-        })
-        .find(|rep| clear(rep))
-        .or(Some(first))
-}
-
 /// [`deliver_learned`] among `obstacles` (table-frame polygons): the special case stands the
 /// robot only where it fits and walks the bound-all circle the way the obstacles leave open.
 /// With a `path` (ending at `goal`) the object is wanted towards the path's moving sub-goal
@@ -454,7 +402,7 @@ pub fn deliver_learned_among(
             step
         };
         let dir_world = if special {
-            let Some(rep) =
+            let Some((rep, radius)) =
                 reachable_reposition(strategy, &ws, obstacles, &o, r.position(), want, bound_all)
             else {
                 return Ok(finish(
@@ -473,7 +421,7 @@ pub fn deliver_learned_among(
             circle_walk(
                 io,
                 o.position(),
-                bound_all,
+                radius,
                 angle_of(rel),
                 p.heading_tolerance,
                 obstacles,

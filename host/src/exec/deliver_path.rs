@@ -14,10 +14,12 @@
 use anyhow::Result;
 use nalgebra::Vector2;
 
-use crate::exec::deliver::{Delivery, DeliveryParams, Failure, Recovery, deliver_learned_among};
+use crate::exec::deliver::{
+    Delivery, DeliveryParams, Failure, Recovery, bound_all_radius, deliver_learned_among,
+};
 use crate::exec::io::RobotIo;
-use crate::exec::io::Workspace;
-use crate::planner::global::{ObstacleParams, clearance, plan_object_path, robot_fits};
+use crate::exec::reposition::approach_radius;
+use crate::planner::global::{ObstacleParams, clearance, plan_object_path};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::Sample;
@@ -106,7 +108,10 @@ pub fn deliver_among_obstacles(
             // A second stall in a row: the robot cannot get behind the object for the way the
             // path wants; push it a little from a side it can reach, then plan again.
             let aside = (stalls_in_a_row > 1)
-                .then(|| side_step(&ws, obstacles, o, sub - o, op))
+                .then(|| {
+                    let bound_all = bound_all_radius(&ws, params.bound_all_margin);
+                    side_step(io, obstacles, strategy, sub - o, op, bound_all)
+                })
                 .flatten();
             let action = match aside {
                 Some(t) => format!(
@@ -181,31 +186,38 @@ fn back_off(io: &mut dyn RobotIo, op: &ObstacleParams) -> Result<()> {
 /// How far a recovery pushes the object aside, m.
 const SIDE_STEP: f64 = 0.08;
 
-/// Where to push an object at `o` that stalled while wanted along `want`: of sixteen
-/// directions, those where the robot can stand behind the object (on its bound-all circle) and
-/// the object ends no closer to an obstacle than its clearance (or than it is now), the one
-/// nearest to `want`.
+/// Where to push the object that stalled while wanted along `want`: of sixteen directions,
+/// those for which the learned special case (Algorithm 2) stands the robot where it fits and
+/// can get to from where it is ([`approach_radius`]) and the object ends no closer to an
+/// obstacle than its clearance (or than it is now), the one nearest to `want`.
 fn side_step(
-    ws: &Workspace,
+    io: &mut dyn RobotIo,
     obstacles: &[Vec<[f64; 2]>],
-    o: Vector2<f64>,
+    strategy: &PushStrategy,
     want: Vector2<f64>,
     op: &ObstacleParams,
+    bound_all: f64,
 ) -> Option<Vector2<f64>> {
     let want = want.try_normalize(1e-9)?;
-    let behind = ws.object_radius + ws.robot_radius + 0.03;
-    let keep = clearance(o, obstacles).min(ws.object_radius + op.object_margin);
+    let (ws, o, from) = (io.workspace(), io.object_pose(), io.robot_pose().position());
+    let ws = &ws;
+    let o = &o;
+    let here = o.position();
+    let keep = clearance(here, obstacles).min(ws.object_radius + op.object_margin);
     (0..16)
         .map(|k| {
             let a = k as f64 * std::f64::consts::TAU / 16.0;
             Vector2::new(a.cos(), a.sin())
         })
         .filter(|d| {
-            let t = o + d * SIDE_STEP;
-            robot_fits(ws, obstacles, o - d * behind)
-                && ws.boundary.contains(t)
+            let t = here + d * SIDE_STEP;
+            let local = o.vector_to_local(*d);
+            ws.boundary.contains(t)
                 && clearance(t, obstacles) >= keep
+                && strategy.special([local.x, local.y]).is_some_and(|rep| {
+                    approach_radius(ws, obstacles, o, from, &rep, bound_all).is_some()
+                })
         })
         .max_by(|a, b| a.dot(&want).total_cmp(&b.dot(&want)))
-        .map(|d| o + d * SIDE_STEP)
+        .map(|d| here + d * SIDE_STEP)
 }

@@ -30,6 +30,7 @@ pub mod plan_source;
 pub mod primitive;
 pub mod rearrange;
 pub mod record;
+pub mod reposition;
 pub mod stable;
 pub mod stable_feedback;
 pub mod stable_replan;

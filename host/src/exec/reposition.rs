@@ -1,0 +1,174 @@
+//! Where the special case of Algorithm 2 (Lau, Mitani & Igarashi §III-E, Fig. 4b) stands the
+//! robot when there are obstacles (the end of §III-E): the learned re-positioning for the
+//! wanted direction, moved only as far as walls make it. The approach comes in closer than the
+//! bound-all circle (Fig. 3) where a wall cuts that circle, and only when no approach works is
+//! the wanted direction turned. [`crate::exec::deliver::deliver_learned_among`] walks the
+//! robot there.
+
+use nalgebra::Vector2;
+
+use crate::exec::io::Workspace;
+use crate::exec::maneuver::around_object;
+use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
+use crate::strategy::regression::{PushStrategy, Reposition};
+use crate::strategy::sample::Pose2;
+
+/// Wanted directions tried, in order, when the robot cannot stand where the special case puts
+/// it: the direction to the goal, then turned either way by up to 90°.
+const SPECIAL_TURNS_DEG: [f64; 13] = [
+    0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 60.0, -60.0, 75.0, -75.0, 90.0, -90.0,
+];
+
+/// The special case's re-positioning (Algorithm 2) for an object at `o` wanted to move along
+/// `want` (object frame), where the robot can stand and get to, with the radius of the circle
+/// about the object it comes in from: the stand point and its approach point must be clear of
+/// the table's edge and of `obstacles`, and a path must lead from the robot at `from` to the
+/// approach point around the obstacles and the object. The approach point lies on the
+/// bound-all circle where that is clear; where a wall cuts the circle there (a corridor), it
+/// comes in closer, down to [`APPROACH_GAP`] outside the stand point. When no approach works,
+/// the wanted direction is turned a little either way ([`SPECIAL_TURNS_DEG`]); the first
+/// direction that works wins, else the untouched one.
+pub(crate) fn reachable_reposition(
+    strategy: &PushStrategy,
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    o: &Pose2,
+    from: Vector2<f64>,
+    want: [f64; 2],
+    bound_all: f64,
+) -> Option<(Reposition, f64)> {
+    let first = strategy.special(want)?;
+    if obstacles.is_empty() {
+        return Some((first, bound_all));
+    }
+    let approach_radius =
+        |rep: &Reposition| approach_radius(ws, obstacles, o, from, rep, bound_all);
+    if let Some(radius) = approach_radius(&first) {
+        return Some((first, radius));
+    }
+    SPECIAL_TURNS_DEG[1..]
+        .iter()
+        .filter_map(|deg| {
+            let (s, c) = deg.to_radians().sin_cos();
+            strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])
+        })
+        .find_map(|rep| approach_radius(&rep).map(|radius| (rep, radius)))
+        .or(Some((first, bound_all)))
+}
+
+/// The radius of the circle about the object at `o` from which the robot, now at `from`,
+/// comes in to push as `rep` says: the bound-all circle where its point is clear, else closer
+/// in 1 cm steps down to [`APPROACH_GAP`] outside the stand point; `None` when the stand point
+/// does not fit or no approach point on that line does with a path to it round `obstacles`
+/// and the object.
+pub(crate) fn approach_radius(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    o: &Pose2,
+    from: Vector2<f64>,
+    rep: &Reposition,
+    bound_all: f64,
+) -> Option<f64> {
+    let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
+    let rel = at - o.position();
+    if !robot_fits(ws, obstacles, at) {
+        return None;
+    }
+    let Some(u) = rel.try_normalize(1e-9) else {
+        return Some(bound_all);
+    };
+    let closest = (rel.norm() + APPROACH_GAP).min(bound_all);
+    let steps = ((bound_all - closest) / 0.01).ceil().max(0.0) as usize;
+    (0..=steps)
+        .map(|k| (bound_all - 0.01 * k as f64).max(closest))
+        .find(|&radius| {
+            let approach = o.position() + radius * u;
+            let around = around_object(ws, obstacles, o.position(), radius);
+            robot_fits(ws, obstacles, approach)
+                && (segment_clear(ws, &around, from, approach)
+                    || plan_robot_path(ws, &around, from, approach).is_some())
+        })
+}
+
+/// The closest the special case's approach comes to the object: this far outside the stand
+/// point, m.
+const APPROACH_GAP: f64 = 0.03;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exec::deliver::bound_all_radius;
+    use crate::exec::io::Rect;
+    use crate::exec::maneuver::angle_of;
+    use crate::strategy::sample::Sample;
+
+    /// A disc-like strategy: pushing from angle a (8 cm out) moves the object towards a + π.
+    fn disc_strategy() -> PushStrategy {
+        let samples = (0..720).map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / 720.0;
+            let push = 0.01 + 0.04 * ((k * 7) % 13) as f64 / 13.0;
+            Sample {
+                p: [0.08 * a.cos(), 0.08 * a.sin()],
+                r: [-push * a.cos(), -push * a.sin()],
+                s: [-0.8 * push * a.cos(), -0.8 * push * a.sin()],
+                theta: 0.0,
+            }
+        });
+        PushStrategy::new(
+            samples,
+            crate::strategy::regression::KernelParams::default(),
+        )
+    }
+
+    /// An object at the bottom of a 0.3 m corridor (walls at x 0.6–0.7 and 1.0–1.1), to be
+    /// pushed right. Its stand point, 8 cm to its left, fits; the bound-all circle's point
+    /// there is inside the left wall. The robot comes in closer, from within the corridor,
+    /// and pushes the way wanted, not a direction turned away from it.
+    #[test]
+    fn in_a_corridor_the_approach_comes_closer_than_the_bound_all_circle() {
+        let ws = Workspace {
+            table: Rect {
+                min: [0.0, 0.0],
+                max: [1.6, 1.2],
+            },
+            boundary: Rect {
+                min: [0.1, 0.1],
+                max: [1.5, 1.1],
+            },
+            robot_radius: 0.04,
+            object_radius: 0.117,
+        };
+        let walls = vec![
+            vec![[0.6, 0.0], [0.7, 0.0], [0.7, 0.8], [0.6, 0.8]],
+            vec![[1.0, 0.4], [1.1, 0.4], [1.1, 1.2], [1.0, 1.2]],
+        ];
+        let strategy = disc_strategy();
+        let o = Pose2::new(0.88, 0.3, 0.0);
+        let bound_all = bound_all_radius(&ws, 0.02);
+        let from = Vector2::new(0.85, 0.6);
+        let (rep, radius) =
+            reachable_reposition(&strategy, &ws, &walls, &o, from, [1.0, 0.0], bound_all)
+                .expect("a re-positioning");
+        let stand = Vector2::new(rep.p[0], rep.p[1]);
+        let push = Vector2::new(rep.r[0], rep.r[1]);
+        assert!(
+            angle_of(-stand).abs() < 10f64.to_radians()
+                && angle_of(push).abs() < 10f64.to_radians(),
+            "stands at {stand:?}, pushes {push:?}"
+        );
+        assert!(radius < bound_all - 0.02, "approach radius {radius}");
+        let approach = o.position() + radius * stand.normalize();
+        assert!(robot_fits(&ws, &walls, approach), "{approach:?}");
+        assert!(!robot_fits(
+            &ws,
+            &walls,
+            o.position() + bound_all * stand.normalize()
+        ));
+        // On an open table the approach stays on the bound-all circle.
+        let open = [vec![[0.0, 1.15], [0.05, 1.15], [0.05, 1.2]]];
+        let (_, radius) =
+            reachable_reposition(&strategy, &ws, &open, &o, from, [1.0, 0.0], bound_all)
+                .expect("a re-positioning");
+        assert_eq!(radius, bound_all);
+    }
+}
