@@ -16,9 +16,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 bin="${CARGO_TARGET_DIR:-target}/debug/pushbot"
-# The test profile (opt-level 1): `cargo test` has just built its library, so only the binary
-# links, and the demo runs faster than at opt-level 0.
-cargo build -q -p pushbot --bin pushbot --profile test
+# The binary `cargo test --workspace` builds for the host's integration tests (test profile,
+# opt-level 1): after the tests nothing is compiled again. A `cargo build` would resolve the
+# dependencies' features without the dev-dependencies and compile the workspace crates anew.
+cargo test -q --workspace --no-run
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

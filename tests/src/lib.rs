@@ -78,11 +78,13 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
 /// The path of a binary of this workspace (`pushbot`, `pushbot-sim`), built first if needed.
 ///
 /// `cargo test -p pushbot-tests` builds this package's dependencies as libraries only, so the
-/// binaries are built here (once per test process) with the cargo that runs the tests, into
-/// the same target directory and profile as the test itself. Both are built by one
-/// `cargo build --workspace --bins`: its features resolve as `cargo test --workspace`'s do, so
-/// the libraries that build has made are reused and only the binaries link (a build of one
-/// package alone resolves its dependencies' features anew and compiles them all again).
+/// binaries are brought up to date here (once per test process) with the cargo that runs the
+/// tests, into the same target directory and profile as the test itself, by
+/// `cargo test --workspace --no-run`: `pushbot` and `pushbot-sim` have integration tests of
+/// their own, so that command builds both binaries, with the features resolved as
+/// `cargo test --workspace` resolves them. After that command has run, nothing is compiled again.
+/// (`cargo build` resolves them without the dev-dependencies, for example `serde` without
+/// `alloc`, and compiled every workspace crate a second time: 2–4 minutes in CI.)
 pub fn bin(name: &str) -> std::path::PathBuf {
     use std::sync::Mutex;
     static BUILT: Mutex<bool> = Mutex::new(false);
@@ -102,23 +104,24 @@ pub fn bin(name: &str) -> std::path::PathBuf {
     if !*built {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let mut cmd = std::process::Command::new(cargo);
-        cmd.args(["build", "--quiet", "--workspace", "--bins"]);
-        // target/release holds `cargo test --release`'s build; target/debug `cargo test`'s,
-        // whose profile is `test` (not `dev`).
+        cmd.args(["test", "--quiet", "--workspace", "--no-run"]);
+        // target/release holds `cargo test --release`'s build.
         if dir.file_name().is_some_and(|p| p == "release") {
             cmd.arg("--release");
-        } else {
-            cmd.args(["--profile", "test"]);
         }
         // Build where the test was built.
         if let Some(target) = dir.parent() {
             cmd.env("CARGO_TARGET_DIR", target);
         }
-        let status = cmd
+        let out = cmd
             .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .status()
-            .expect("run cargo build");
-        assert!(status.success(), "cargo build --workspace --bins failed");
+            .output()
+            .expect("run cargo test --no-run");
+        assert!(
+            out.status.success(),
+            "cargo test --workspace --no-run failed:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         *built = true;
     }
     assert!(path.exists(), "{} was not built", path.display());
