@@ -58,9 +58,12 @@ if [ "$(grep -c . <<<"$sim_files")" -gt 3 ] || grep -v '^host/src/sim/' <<<"$sim
   exit 1
 fi
 cargo clippy -p pushbot --no-default-features --lib --bins -- -D warnings
-cargo build -p pushbot --no-default-features
+# Built once, to run one command: the `nosim` profile leaves the dependencies unoptimised
+# (the dev profile optimises them for the tests' simulations). From scratch on 2 cores this
+# build takes 2m53s, against 7m50s with the dev profile.
+cargo build -p pushbot --no-default-features --profile nosim
 set +e
-msg=$(target/debug/pushbot robot info 2>&1)
+msg=$(target/nosim/pushbot robot info 2>&1)
 code=$?
 set -e
 echo "$msg"
