@@ -47,7 +47,9 @@ fn track_fast(x: f64, y: f64, theta: f64, v: f32, omega: f32, secs: f64) -> Scor
     // The marker in the robot's middle: the pose tracked is scored against the marker's true
     // centre (the lau presets put it 3 cm behind).
     scene.camera.robot_marker.x = 0.0;
-    let t = SimTarget::start(&scene, 31, 1.0, None, None).expect("start the simulated target");
+    // At half real time: the camera renders as fast as the machine lets it, and on a loaded
+    // machine real time left fewer than the 10 frames `check` scores (5 and 7 seen in CI).
+    let t = SimTarget::start(&scene, 31, 0.5, None, None).expect("start the simulated target");
     let robot = Robot::connect(t.port(), LinkOptions::default()).expect("connect");
     // As fast as the firmware's hard limits let it: 0.45 m/s at 2 m/s², 8 rad/s at 40 rad/s².
     robot
