@@ -2,6 +2,7 @@
 //!
 //! * [`Pose`] — the one planar pose (SE(2), on `nalgebra`);
 //! * [`geometry`] — outlines as convex parts and their overlaps, on `parry2d`;
+//! * [`enclosing_circle`] — the smallest circle enclosing a point set (Welzl);
 //! * [`polygon`] — simple-polygon checks in O(n log n) and winding normalisation;
 //! * [`board`] — the lens-calibration board: an AprilTag grid and its layout file;
 //! * [`body`] — the robot's build (round bumper, front plate, switches);
@@ -23,6 +24,7 @@ pub mod board;
 pub mod body;
 pub mod camera;
 pub mod camera_pose;
+pub mod enclosing_circle;
 pub mod geometry;
 pub mod lens;
 pub mod lens_file;

@@ -33,7 +33,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::exec::deliver::{DeliveryParams, Failure, bound_all_radius, deliver_learned};
 use crate::exec::io::RobotIo;
-use crate::exec::maneuver::{Turn, circle_walk, face};
+use crate::exec::maneuver::{Drive, Turn, circle_walk, face};
 use crate::strategy::active::{Selection, least_known, least_known_ahead};
 use crate::strategy::regression::{Admission, PushStrategy};
 use crate::strategy::sample::Sample;
@@ -195,7 +195,14 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             push_angle.to_degrees(),
             base.to_degrees()
         );
-        circle_walk(io, o.position(), radius, push_angle, 0.05, &[])?;
+        circle_walk(
+            io,
+            o.position(),
+            radius,
+            push_angle,
+            &Drive::two_level(0.05),
+            &[],
+        )?;
         let o0 = io.object_pose().position();
         // (d) Push towards the object until it is back inside; give up this round when six
         // pushes running did not bring it closer (it slides along the boundary, or is stuck).
@@ -372,7 +379,14 @@ fn coverage_push(
     if !ws.reachable().contains(stand) {
         return Ok(None);
     }
-    circle_walk(io, o.position(), radius, stand_angle, 0.05, &[])?;
+    circle_walk(
+        io,
+        o.position(),
+        radius,
+        stand_angle,
+        &Drive::two_level(0.05),
+        &[],
+    )?;
     // reset_robot's approach (face the marker, creep until the object moves), then a push
     // straight on, as the initial collection's pushes start from a touch.
     if !reset_robot(io, params.epsilon)? {

@@ -18,7 +18,7 @@ use crate::exec::deliver::{
     Delivery, DeliveryParams, Failure, Recovery, bound_all_radius, deliver_learned_among,
 };
 use crate::exec::io::RobotIo;
-use crate::exec::reposition::approach_radius;
+use crate::exec::reposition::{BoundAll, approach_radius};
 use crate::planner::global::{ObstacleParams, clearance, plan_object_path};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::regression::PushStrategy;
@@ -56,10 +56,16 @@ pub fn deliver_among_obstacles(
     // kept closer to the path), back to the default after progress.
     let mut lookahead = op.lookahead;
     let mut stalls_in_a_row = 0;
+    // The path is planned for the object's smallest enclosing circle (its outline swept
+    // through every rotation about that circle's centre), not for the circle round its marker:
+    // for an object marked off its middle (the L-shape's marker is in its corner, 11.7 cm from
+    // its furthest vertex against 9.2 cm) the marker's circle closes a 0.3 m corridor to a
+    // 4.6 cm band and still lets the outline touch a wall when the marker is in the middle.
+    let body_ws = ws.body_workspace();
     loop {
-        let o = io.object_pose().position();
+        let o = ws.body_centre(&io.object_pose());
         let left = params.time_limit - (io.time() - start);
-        let Some(path) = plan_object_path(&ws, obstacles, o, goal, op) else {
+        let Some(path) = plan_object_path(&body_ws, obstacles, o, goal, op) else {
             all.failure = Some(Failure::NoPath);
             break;
         };
@@ -89,7 +95,7 @@ pub fn deliver_among_obstacles(
         )?;
         let failure = d.failure;
         add_leg(&mut all, d);
-        let o = io.object_pose().position();
+        let o = ws.body_centre(&io.object_pose());
         let sub = follow.aim(o).subgoal;
         subgoals.push([sub.x, sub.y]);
         if failure == Some(Failure::Stalled) {
@@ -109,8 +115,11 @@ pub fn deliver_among_obstacles(
             // path wants; push it a little from a side it can reach, then plan again.
             let aside = (stalls_in_a_row > 1)
                 .then(|| {
-                    let bound_all = bound_all_radius(&ws, params.bound_all_margin);
-                    side_step(io, obstacles, strategy, sub - o, op, bound_all)
+                    let bound_all = BoundAll {
+                        centre: io.object_pose().position(),
+                        radius: bound_all_radius(&ws, params.bound_all_margin),
+                    };
+                    side_step(io, obstacles, strategy, sub - o, op, &bound_all)
                 })
                 .flatten();
             let action = match aside {
@@ -186,24 +195,25 @@ fn back_off(io: &mut dyn RobotIo, op: &ObstacleParams) -> Result<()> {
 /// How far a recovery pushes the object aside, m.
 const SIDE_STEP: f64 = 0.08;
 
-/// Where to push the object that stalled while wanted along `want`: of sixteen directions,
-/// those for which the learned special case (Algorithm 2) stands the robot where it fits and
-/// can get to from where it is ([`approach_radius`]) and the object ends no closer to an
-/// obstacle than its clearance (or than it is now), the one nearest to `want`.
+/// Where to push the object's marker when it stalled while wanted along `want`: of sixteen
+/// directions, those for which the learned special case (Algorithm 2) stands the robot where
+/// it fits and can get to from where it is ([`approach_radius`]) and the object's enclosing
+/// circle ends no closer to an obstacle than its clearance (or than it is now), the one
+/// nearest to `want`.
 fn side_step(
     io: &mut dyn RobotIo,
     obstacles: &[Vec<[f64; 2]>],
     strategy: &PushStrategy,
     want: Vector2<f64>,
     op: &ObstacleParams,
-    bound_all: f64,
+    bound_all: &BoundAll,
 ) -> Option<Vector2<f64>> {
     let want = want.try_normalize(1e-9)?;
     let (ws, o, from) = (io.workspace(), io.object_pose(), io.robot_pose().position());
     let ws = &ws;
     let o = &o;
-    let here = o.position();
-    let keep = clearance(here, obstacles).min(ws.object_radius + op.object_margin);
+    let here = ws.body_centre(o);
+    let keep = clearance(here, obstacles).min(ws.body.radius + op.object_margin);
     (0..16)
         .map(|k| {
             let a = k as f64 * std::f64::consts::TAU / 16.0;
@@ -212,12 +222,12 @@ fn side_step(
         .filter(|d| {
             let t = here + d * SIDE_STEP;
             let local = o.vector_to_local(*d);
-            ws.boundary.contains(t)
+            ws.boundary.contains(o.position() + d * SIDE_STEP)
                 && clearance(t, obstacles) >= keep
                 && strategy.special([local.x, local.y]).is_some_and(|rep| {
                     approach_radius(ws, obstacles, o, from, &rep, bound_all).is_some()
                 })
         })
         .max_by(|a, b| a.dot(&want).total_cmp(&b.dot(&want)))
-        .map(|d| here + d * SIDE_STEP)
+        .map(|d| o.position() + d * SIDE_STEP)
 }

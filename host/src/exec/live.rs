@@ -29,6 +29,7 @@ use crate::vision::calibration::Calibration;
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
 use crate::vision::tracking::TrackerParams;
+use pushbot_world::workspace::object_bounds;
 
 /// Settings of a [`LiveRobot`].
 #[derive(Debug, Clone, PartialEq)]
@@ -175,12 +176,7 @@ impl LiveRobot {
         let marker = object
             .and_then(|o| o.marker)
             .map_or([0.0, 0.0], |m| [m.x, m.y]);
-        let object_radius = object.map_or(0.0, |o| {
-            o.outline
-                .iter()
-                .map(|v| (v[0] - marker[0]).hypot(v[1] - marker[1]))
-                .fold(0.0, f64::max)
-        });
+        let (object_radius, body) = object_bounds(object.map_or(&[][..], |o| &o.outline), marker);
         let table = Rect {
             min: [0.0, 0.0],
             max: [scene.table.width, scene.table.height],
@@ -190,6 +186,7 @@ impl LiveRobot {
             boundary: table.inset(opts.boundary_inset),
             robot_radius: scene.robot.bumper_radius,
             object_radius,
+            body,
         };
         let robot = Robot::connect(port, opts.link.clone())
             .with_context(|| format!("connecting to the robot on {port}"))?;

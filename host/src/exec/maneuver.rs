@@ -190,13 +190,15 @@ pub fn transit(
 /// Move the robot around the circle of radius `radius` about `centre` (Fig. 3 a–c): first to
 /// the circle's closest point, then along it in chords of at most 30° to the point at angle
 /// `to`, going the way that keeps the robot on the table and off the `obstacles` (points the
-/// robot cannot reach are pulled back onto the table).
+/// robot cannot reach are pulled back onto the table). The walk's end is driven to as `end`
+/// says; the points on the way, which need no precision (each chord starts from a fresh
+/// measurement), with one leg each ([`Drive::one_leg`], within [`WAY_POINT_ARRIVE`]).
 pub fn circle_walk(
     io: &mut dyn RobotIo,
     centre: Vector2<f64>,
     radius: f64,
     to: f64,
-    tol: f64,
+    end: &Drive,
     obstacles: &[Vec<[f64; 2]>],
 ) -> Result<()> {
     let ws = io.workspace();
@@ -221,18 +223,19 @@ pub fn circle_walk(
     // robot would join it: the stand point is reached by a path around the obstacles and the
     // object instead.
     let cut = !obstacles.is_empty() && circle_cut(&ws, obstacles, &on, from, to, inside);
+    let way = Drive::one_leg(WAY_POINT_ARRIVE);
     if inside {
         // Back straight away from the centre onto the circle.
-        face(io, angle_of(-rel), &Turn::two_level(tol))?;
+        face(io, angle_of(-rel), &end.turn)?;
         let back = clamp(on(from)) - io.robot_pose().position();
         io.forward(-back.norm())?;
     }
     if cut {
-        return transit(io, on(to), &around, &Drive::two_level(tol));
+        return transit(io, on(to), &around, end);
     }
     if !inside {
         // From afar, around the obstacles and the object itself.
-        transit(io, clamp(on(from)), &around, &Drive::two_level(tol))?;
+        transit(io, clamp(on(from)), &around, &way)?;
     }
     let (a, b) = circle_routes(from, to);
     let blocked = |pts: &[f64]| {
@@ -241,11 +244,15 @@ pub fn circle_walk(
             .count()
     };
     let pts = if blocked(&a) <= blocked(&b) { a } else { b };
-    for ang in pts {
-        go_to(io, clamp(on(ang)), &Drive::two_level(tol))?;
+    let last = pts.len().saturating_sub(1);
+    for (k, ang) in pts.into_iter().enumerate() {
+        go_to(io, clamp(on(ang)), if k == last { end } else { &way })?;
     }
     Ok(())
 }
+
+/// How near a walk's way points the robot must come, m.
+pub const WAY_POINT_ARRIVE: f64 = 0.01;
 
 /// `obstacles` and, when there are any, the object inside the bound-all circle of `radius`
 /// about `centre` as one more (a 12-gon the robot on the circle clears): what a path to a
@@ -325,6 +332,10 @@ mod tests {
             },
             robot_radius: 0.04,
             object_radius: 0.075,
+            body: pushbot_world::enclosing_circle::Circle {
+                centre: [0.0, 0.0],
+                radius: 0.075,
+            },
         }
     }
 
@@ -354,5 +365,63 @@ mod tests {
         assert!(!circle_cut(&ws, &far, &on, PI, 0.0, false));
         // A stand point inside the wall.
         assert!(!circle_cut(&ws, &walls, &on, FRAC_PI_2, PI, true));
+    }
+
+    /// A robot on the open table that turns and drives 10 % short of what it is asked,
+    /// counting its drives.
+    struct Short {
+        pose: Pose2,
+        drives: usize,
+    }
+
+    impl RobotIo for Short {
+        fn spin(&mut self, angle: f64) -> Result<()> {
+            self.pose.theta = wrap_angle(self.pose.theta + 0.9 * angle);
+            Ok(())
+        }
+        fn forward(&mut self, distance: f64) -> Result<()> {
+            let (s, c) = self.pose.theta.sin_cos();
+            self.pose.x += 0.9 * distance * c;
+            self.pose.y += 0.9 * distance * s;
+            self.drives += 1;
+            Ok(())
+        }
+        fn drive(&mut self, _: f64, _: f64, _: f64) -> Result<()> {
+            anyhow::bail!("not used")
+        }
+        fn robot_pose(&mut self) -> Pose2 {
+            self.pose
+        }
+        fn object_pose(&mut self) -> Pose2 {
+            Pose2::new(0.85, 0.5, 0.0)
+        }
+        fn body_pose(&mut self, _: &str) -> Option<Pose2> {
+            None
+        }
+        fn time(&self) -> f64 {
+            0.0
+        }
+        fn workspace(&self) -> Workspace {
+            ws()
+        }
+    }
+
+    /// From 3 cm outside the circle half way round: onto the circle and five way points, each
+    /// one turn and one drive (a second leg would correct the 10 % shortfall, about 8 mm,
+    /// which a way point does not need), and the end driven to as asked: two legs of the
+    /// paper's two levels, ending within 5 mm.
+    #[test]
+    fn a_walk_drives_each_way_point_once_and_its_end_as_asked() {
+        let c = Vector2::new(0.85, 0.5);
+        let mut io = Short {
+            pose: Pose2::new(0.85 + 0.185, 0.5, std::f64::consts::PI),
+            drives: 0,
+        };
+        let end = Drive::two_level(0.05);
+        circle_walk(&mut io, c, 0.155, std::f64::consts::PI, &end, &[]).unwrap();
+        let target = c - Vector2::new(0.155, 0.0);
+        let miss = (io.pose.position() - target).norm();
+        assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
+        assert_eq!(io.drives, 1 + 5 + 2, "drives");
     }
 }

@@ -13,6 +13,15 @@ use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
 use crate::strategy::regression::{PushStrategy, Reposition};
 use crate::strategy::sample::Pose2;
 
+/// The bound-all circle (Fig. 3) the special case walks the robot round the object on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundAll {
+    /// Centre, table frame.
+    pub centre: Vector2<f64>,
+    /// Radius, m.
+    pub radius: f64,
+}
+
 /// Wanted directions tried, in order, when the robot cannot stand where the special case puts
 /// it: the direction to the goal, then turned either way by up to 90°.
 const SPECIAL_TURNS_DEG: [f64; 13] = [
@@ -35,11 +44,11 @@ pub(crate) fn reachable_reposition(
     o: &Pose2,
     from: Vector2<f64>,
     want: [f64; 2],
-    bound_all: f64,
+    bound_all: &BoundAll,
 ) -> Option<(Reposition, f64)> {
     let first = strategy.special(want)?;
     if obstacles.is_empty() {
-        return Some((first, bound_all));
+        return Some((first, bound_all.radius));
     }
     let approach_radius =
         |rep: &Reposition| approach_radius(ws, obstacles, o, from, rep, bound_all);
@@ -53,10 +62,10 @@ pub(crate) fn reachable_reposition(
             strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])
         })
         .find_map(|rep| approach_radius(&rep).map(|radius| (rep, radius)))
-        .or(Some((first, bound_all)))
+        .or(Some((first, bound_all.radius)))
 }
 
-/// The radius of the circle about the object at `o` from which the robot, now at `from`,
+/// The radius of the circle about the bound-all circle's centre from which the robot, now at `from`,
 /// comes in to push as `rep` says: the bound-all circle where its point is clear, else closer
 /// in 1 cm steps down to [`APPROACH_GAP`] outside the stand point; `None` when the stand point
 /// does not fit or no approach point on that line does with a path to it round `obstacles`
@@ -67,10 +76,11 @@ pub(crate) fn approach_radius(
     o: &Pose2,
     from: Vector2<f64>,
     rep: &Reposition,
-    bound_all: f64,
+    circle: &BoundAll,
 ) -> Option<f64> {
+    let (centre, bound_all) = (circle.centre, circle.radius);
     let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
-    let rel = at - o.position();
+    let rel = at - centre;
     if !robot_fits(ws, obstacles, at) {
         return None;
     }
@@ -82,8 +92,8 @@ pub(crate) fn approach_radius(
     (0..=steps)
         .map(|k| (bound_all - 0.01 * k as f64).max(closest))
         .find(|&radius| {
-            let approach = o.position() + radius * u;
-            let around = around_object(ws, obstacles, o.position(), radius);
+            let approach = centre + radius * u;
+            let around = around_object(ws, obstacles, centre, radius);
             robot_fits(ws, obstacles, approach)
                 && (segment_clear(ws, &around, from, approach)
                     || plan_robot_path(ws, &around, from, approach).is_some())
@@ -137,6 +147,10 @@ mod tests {
             },
             robot_radius: 0.04,
             object_radius: 0.117,
+            body: pushbot_world::enclosing_circle::Circle {
+                centre: [0.0, 0.0],
+                radius: 0.117,
+            },
         };
         let walls = vec![
             vec![[0.6, 0.0], [0.7, 0.0], [0.7, 0.8], [0.6, 0.8]],
@@ -145,9 +159,13 @@ mod tests {
         let strategy = disc_strategy();
         let o = Pose2::new(0.88, 0.3, 0.0);
         let bound_all = bound_all_radius(&ws, 0.02);
+        let circle = BoundAll {
+            centre: o.position(),
+            radius: bound_all,
+        };
         let from = Vector2::new(0.85, 0.6);
         let (rep, radius) =
-            reachable_reposition(&strategy, &ws, &walls, &o, from, [1.0, 0.0], bound_all)
+            reachable_reposition(&strategy, &ws, &walls, &o, from, [1.0, 0.0], &circle)
                 .expect("a re-positioning");
         let stand = Vector2::new(rep.p[0], rep.p[1]);
         let push = Vector2::new(rep.r[0], rep.r[1]);
@@ -167,7 +185,7 @@ mod tests {
         // On an open table the approach stays on the bound-all circle.
         let open = [vec![[0.0, 1.15], [0.05, 1.15], [0.05, 1.2]]];
         let (_, radius) =
-            reachable_reposition(&strategy, &ws, &open, &o, from, [1.0, 0.0], bound_all)
+            reachable_reposition(&strategy, &ws, &open, &o, from, [1.0, 0.0], &circle)
                 .expect("a re-positioning");
         assert_eq!(radius, bound_all);
     }

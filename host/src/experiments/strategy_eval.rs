@@ -100,10 +100,12 @@ pub fn run_start(
             );
         }
         let obstacles = scene_obstacles(&setup.scene);
+        // The yardstick is the shortest path of the outline's smallest enclosing circle (the
+        // outline turning freely), from where its centre starts.
         let shortest = shortest_object_path(
-            &ws,
+            &ws.body_workspace(),
             &obstacles,
-            o.position(),
+            ws.body_centre(&o),
             goal,
             &ObstacleParams::default(),
         )

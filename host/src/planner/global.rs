@@ -4,9 +4,12 @@
 //! sub-goals of this path". A pure planner: a function of the workspace, the obstacles and the
 //! goal; [`crate::exec::deliver_path`] pushes along it.
 //!
-//! The planner is A* (the `pathfinding` crate) on a grid over the boundary, for the object's
-//! marker. A cell is free when the object's bounding circle (around its marker) clears every
-//! obstacle by a small margin and the marker stays inside the boundary. The robot's room to push
+//! The planner is A* (the `pathfinding` crate) on a grid over the boundary, for a reference
+//! point of the object with a bounding circle about it (`Workspace::object_radius`): the
+//! delivery plans for the centre of the smallest circle enclosing the outline (the outline
+//! swept through every rotation about it, `Workspace::body_workspace`). A cell is free when the
+//! bounding circle clears every obstacle by a small margin and the point stays inside the
+//! boundary. The robot's room to push
 //! is a cost, not a wall: cells where the robot could not circle the object on its bound-all
 //! circle (Fig. 3) — closer to an obstacle than the object's radius plus the robot's diameter
 //! plus a margin — may cost `room_penalty` times as much, so the path keeps that room wherever
@@ -127,8 +130,8 @@ impl Clearances {
 /// path begins, m.
 const ESCAPE: f64 = 0.15;
 
-/// A global path for the object's marker from `start` to `goal` among `obstacles` (table-frame
-/// polygons), inside the workspace's boundary; `None` when there is none. The path runs from
+/// A global path for the object's reference point (the centre of `ws.object_radius`'s circle)
+/// from `start` to `goal` among `obstacles` (table-frame polygons), inside the workspace's boundary; `None` when there is none. The path runs from
 /// `start` to `goal` through grid cell centres.
 pub fn plan_object_path(
     ws: &Workspace,
@@ -295,6 +298,10 @@ pub fn plan_robot_path(
     let disc = Workspace {
         boundary: ws.reachable(),
         object_radius: ws.robot_radius,
+        body: pushbot_world::enclosing_circle::Circle {
+            centre: [0.0, 0.0],
+            radius: ws.robot_radius,
+        },
         ..*ws
     };
     let op = ObstacleParams {
@@ -308,10 +315,11 @@ pub fn plan_robot_path(
     Some(pull_taut(&path, |a, b| segment_clear(ws, obstacles, a, b)))
 }
 
-/// The shortest collision-free path of the object's marker from `start` to `goal`: its
-/// bounding circle (around the marker) clear of every obstacle by `op.object_margin` and the
-/// marker inside the boundary, with no regard for the robot's room — the yardstick the
-/// delivered path is measured against. A* on the grid, then pulled taut (a way point kept only
+/// The shortest collision-free path of the object's reference point from `start` to `goal`:
+/// its bounding circle (`ws.object_radius` round that point; for the object's body, the
+/// smallest circle enclosing its outline, [`Workspace::body_workspace`]) clear of every
+/// obstacle by `op.object_margin` and the point inside the boundary, with no regard for the
+/// robot's room — the yardstick the delivered path is measured against. A* on the grid, then pulled taut (a way point kept only
 /// where the straight way from the previous one is blocked). `None` when there is none.
 pub fn shortest_object_path(
     ws: &Workspace,
@@ -402,6 +410,10 @@ mod tests {
             },
             robot_radius: 0.04,
             object_radius: 0.07,
+            body: pushbot_world::enclosing_circle::Circle {
+                centre: [0.0, 0.0],
+                radius: 0.07,
+            },
         }
     }
 

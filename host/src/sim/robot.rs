@@ -20,6 +20,7 @@ use crate::exec::occlusion::{self, BodyLost, Looking};
 use crate::link::{LinkError, Refusal};
 use crate::robot::{LinkOptions, Robot};
 use crate::strategy::sample::{Pose2, wrap_angle};
+use pushbot_world::workspace::object_bounds;
 
 /// Settings of the in-process robot.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,11 +158,7 @@ impl SimRobot {
         let scene_round = scene.robot.front_plate.is_none();
         let robot_marker = [scene.camera.robot_marker.x, scene.camera.robot_marker.y];
         let marker = obj.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
-        let object_radius = obj
-            .outline
-            .iter()
-            .map(|v| (v[0] - marker[0]).hypot(v[1] - marker[1]))
-            .fold(0.0, f64::max);
+        let (object_radius, body) = object_bounds(&obj.outline, marker);
         let scene_table = Rect {
             min: [0.0, 0.0],
             max: [scene.table.width, scene.table.height],
@@ -179,6 +176,7 @@ impl SimRobot {
             boundary: scene_table.inset(opts.boundary_inset),
             robot_radius: scene.robot.bumper_radius,
             object_radius,
+            body,
         };
         if workspace.boundary.min[0] >= workspace.boundary.max[0]
             || workspace.boundary.min[1] >= workspace.boundary.max[1]
