@@ -24,6 +24,14 @@ pub struct Circle {
 const SLACK: f64 = 1e-9;
 
 impl Circle {
+    /// A circle of `radius` about the origin.
+    pub fn at_origin(radius: f64) -> Circle {
+        Circle {
+            centre: [0.0, 0.0],
+            radius,
+        }
+    }
+
     /// Whether `p` lies inside or on the circle.
     pub fn contains(&self, p: [f64; 2]) -> bool {
         dist(self.centre, p) <= self.radius * (1.0 + SLACK) + SLACK

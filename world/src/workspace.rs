@@ -82,10 +82,7 @@ pub fn object_bounds(outline: &[[f64; 2]], marker: [f64; 2]) -> (f64, Circle) {
         .map(|v| [v[0] - marker[0], v[1] - marker[1]])
         .collect();
     let radius = about.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
-    let body = enclosing_circle(&about).unwrap_or(Circle {
-        centre: [0.0, 0.0],
-        radius,
-    });
+    let body = enclosing_circle(&about).unwrap_or(Circle::at_origin(radius));
     (radius, body)
 }
 
@@ -96,10 +93,7 @@ impl Workspace {
     pub fn body_workspace(&self) -> Workspace {
         Workspace {
             object_radius: self.body.radius,
-            body: Circle {
-                centre: [0.0, 0.0],
-                radius: self.body.radius,
-            },
+            body: Circle::at_origin(self.body.radius),
             ..*self
         }
     }

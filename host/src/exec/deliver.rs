@@ -178,6 +178,23 @@ pub fn bound_all_radius(ws: &Workspace, margin: f64) -> f64 {
     ws.object_radius + ws.robot_radius + margin
 }
 
+/// The bound-all circle (Fig. 3) of the object whose marker is at `o`: about the marker
+/// ([`bound_all_radius`]), or with `body` about the outline's smallest enclosing circle (its
+/// radius + robot radius + margin).
+pub(crate) fn bound_all_circle(ws: &Workspace, o: &Pose2, margin: f64, body: bool) -> BoundAll {
+    if body {
+        BoundAll {
+            centre: ws.body_centre(o),
+            radius: ws.body.radius + ws.robot_radius + margin,
+        }
+    } else {
+        BoundAll {
+            centre: o.position(),
+            radius: bound_all_radius(ws, margin),
+        }
+    }
+}
+
 /// Camera noise dead-band of a measured track, m: a step is counted once the body is this far
 /// from the last point counted. Between two looks at a still body the camera's noise (about
 /// 1 mm) moves it by 1.8 mm on average, which over hundreds of looks would add metres to a path
@@ -344,19 +361,7 @@ pub fn deliver_learned_among(
     // marker (as the strategy was collected); among obstacles about the outline's smallest
     // enclosing circle, which for an object marked off its middle is up to a fifth smaller
     // (the L-shape: 15.2 cm against 17.7 cm) and leaves the walk room in a corridor.
-    let circle_of = |o: &Pose2| {
-        if !obstacles.is_empty() {
-            BoundAll {
-                centre: ws.body_centre(o),
-                radius: ws.body.radius + ws.robot_radius + p.bound_all_margin,
-            }
-        } else {
-            BoundAll {
-                centre: o.position(),
-                radius: bound_all_radius(&ws, p.bound_all_margin),
-            }
-        }
-    };
+    let circle_of = |o: &Pose2| bound_all_circle(&ws, o, p.bound_all_margin, !obstacles.is_empty());
     let mut traj = Vec::new();
     let (mut steps, mut repositions) = (0, 0);
     let mut special = {
@@ -376,9 +381,10 @@ pub fn deliver_learned_among(
         // Along a path the object's enclosing circle follows it (the path is planned for that
         // circle, [`crate::exec::deliver_path`]) until the moving sub-goal is the goal itself;
         // from there the marker is pushed to the goal, and progress is watched afresh on it.
+        let centre = ws.body_centre(&o);
         let (on_centre, aim, left) = match path.as_deref_mut() {
             Some(f) => {
-                let a = f.aim(ws.body_centre(&o));
+                let a = f.aim(centre);
                 if (a.subgoal - goal).norm() > 1e-9 {
                     (true, a.subgoal, a.left)
                 } else {
@@ -395,12 +401,7 @@ pub fn deliver_learned_among(
             let v = Err(Failure::Stalled);
             return Ok(finish(io, start, goal, v, steps, repositions, traj));
         }
-        let from = if on_centre {
-            ws.body_centre(&o)
-        } else {
-            o.position()
-        };
-        let to_aim = aim - from;
+        let to_aim = aim - if on_centre { centre } else { o.position() };
         let to_aim = to_aim.try_normalize(1e-9).unwrap_or_else(|| {
             (goal - o.position())
                 .try_normalize(1e-9)

@@ -15,7 +15,7 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use crate::exec::deliver::{
-    Delivery, DeliveryParams, Failure, Recovery, bound_all_radius, deliver_learned_among,
+    Delivery, DeliveryParams, Failure, Recovery, bound_all_circle, deliver_learned_among,
 };
 use crate::exec::io::RobotIo;
 use crate::exec::reposition::{BoundAll, approach_radius};
@@ -95,8 +95,9 @@ pub fn deliver_among_obstacles(
         )?;
         let failure = d.failure;
         add_leg(&mut all, d);
-        let o = ws.body_centre(&io.object_pose());
-        let sub = follow.aim(o).subgoal;
+        let marker = io.object_pose();
+        let (o, centre) = (marker.position(), ws.body_centre(&marker));
+        let sub = follow.aim(centre).subgoal;
         subgoals.push([sub.x, sub.y]);
         if failure == Some(Failure::Stalled) {
             if all.recoveries.len() >= op.max_recoveries {
@@ -115,11 +116,8 @@ pub fn deliver_among_obstacles(
             // path wants; push it a little from a side it can reach, then plan again.
             let aside = (stalls_in_a_row > 1)
                 .then(|| {
-                    let bound_all = BoundAll {
-                        centre: io.object_pose().position(),
-                        radius: bound_all_radius(&ws, params.bound_all_margin),
-                    };
-                    side_step(io, obstacles, strategy, sub - o, op, &bound_all)
+                    let bound_all = bound_all_circle(&ws, &marker, params.bound_all_margin, false);
+                    side_step(io, obstacles, strategy, sub - centre, op, &bound_all)
                 })
                 .flatten();
             let action = match aside {

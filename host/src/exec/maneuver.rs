@@ -332,10 +332,7 @@ mod tests {
             },
             robot_radius: 0.04,
             object_radius: 0.075,
-            body: pushbot_world::enclosing_circle::Circle {
-                centre: [0.0, 0.0],
-                radius: 0.075,
-            },
+            body: pushbot_world::enclosing_circle::Circle::at_origin(0.075),
         }
     }
 

@@ -65,11 +65,11 @@ pub(crate) fn reachable_reposition(
         .or(Some((first, bound_all.radius)))
 }
 
-/// The radius of the circle about the bound-all circle's centre from which the robot, now at `from`,
-/// comes in to push as `rep` says: the bound-all circle where its point is clear, else closer
-/// in 1 cm steps down to [`APPROACH_GAP`] outside the stand point; `None` when the stand point
-/// does not fit or no approach point on that line does with a path to it round `obstacles`
-/// and the object.
+/// The radius of the circle about the bound-all circle's centre from which the robot, now at
+/// `from`, comes in to push as `rep` says: the bound-all circle where its point is clear, else
+/// closer in 1 cm steps down to [`APPROACH_GAP`] outside the stand point; `None` when the
+/// stand point does not fit or no approach point on that line does with a path to it round
+/// `obstacles` and the object.
 pub(crate) fn approach_radius(
     ws: &Workspace,
     obstacles: &[Vec<[f64; 2]>],
@@ -147,10 +147,7 @@ mod tests {
             },
             robot_radius: 0.04,
             object_radius: 0.117,
-            body: pushbot_world::enclosing_circle::Circle {
-                centre: [0.0, 0.0],
-                radius: 0.117,
-            },
+            body: pushbot_world::enclosing_circle::Circle::at_origin(0.117),
         };
         let walls = vec![
             vec![[0.6, 0.0], [0.7, 0.0], [0.7, 0.8], [0.6, 0.8]],

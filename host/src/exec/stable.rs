@@ -337,10 +337,7 @@ mod tests {
                 boundary: table,
                 robot_radius: 0.04,
                 object_radius: 0.12,
-                body: pushbot_world::enclosing_circle::Circle {
-                    centre: [0.0, 0.0],
-                    radius: 0.12,
-                },
+                body: pushbot_world::enclosing_circle::Circle::at_origin(0.12),
             }
         }
     }

@@ -9,8 +9,7 @@
 //! delivery plans for the centre of the smallest circle enclosing the outline (the outline
 //! swept through every rotation about it, `Workspace::body_workspace`). A cell is free when the
 //! bounding circle clears every obstacle by a small margin and the point stays inside the
-//! boundary. The robot's room to push
-//! is a cost, not a wall: cells where the robot could not circle the object on its bound-all
+//! boundary. The robot's room to push is a cost, not a wall: cells where the robot could not circle the object on its bound-all
 //! circle (Fig. 3) — closer to an obstacle than the object's radius plus the robot's diameter
 //! plus a margin — may cost `room_penalty` times as much, so the path keeps that room wherever
 //! the free space allows (off by default, see [`ObstacleParams::room_penalty`]). A move also needs the robot's
@@ -131,8 +130,9 @@ impl Clearances {
 const ESCAPE: f64 = 0.15;
 
 /// A global path for the object's reference point (the centre of `ws.object_radius`'s circle)
-/// from `start` to `goal` among `obstacles` (table-frame polygons), inside the workspace's boundary; `None` when there is none. The path runs from
-/// `start` to `goal` through grid cell centres.
+/// from `start` to `goal` among `obstacles` (table-frame polygons), inside the workspace's
+/// boundary; `None` when there is none. The path runs from `start` to `goal` through grid cell
+/// centres.
 pub fn plan_object_path(
     ws: &Workspace,
     obstacles: &[Vec<[f64; 2]>],
@@ -298,10 +298,7 @@ pub fn plan_robot_path(
     let disc = Workspace {
         boundary: ws.reachable(),
         object_radius: ws.robot_radius,
-        body: pushbot_world::enclosing_circle::Circle {
-            centre: [0.0, 0.0],
-            radius: ws.robot_radius,
-        },
+        body: pushbot_world::enclosing_circle::Circle::at_origin(ws.robot_radius),
         ..*ws
     };
     let op = ObstacleParams {
@@ -319,8 +316,9 @@ pub fn plan_robot_path(
 /// its bounding circle (`ws.object_radius` round that point; for the object's body, the
 /// smallest circle enclosing its outline, [`Workspace::body_workspace`]) clear of every
 /// obstacle by `op.object_margin` and the point inside the boundary, with no regard for the
-/// robot's room — the yardstick the delivered path is measured against. A* on the grid, then pulled taut (a way point kept only
-/// where the straight way from the previous one is blocked). `None` when there is none.
+/// robot's room — the yardstick the delivered path is measured against. A* on the grid, then
+/// pulled taut (a way point kept only where the straight way from the previous one is
+/// blocked). `None` when there is none.
 pub fn shortest_object_path(
     ws: &Workspace,
     obstacles: &[Vec<[f64; 2]>],
@@ -410,10 +408,7 @@ mod tests {
             },
             robot_radius: 0.04,
             object_radius: 0.07,
-            body: pushbot_world::enclosing_circle::Circle {
-                centre: [0.0, 0.0],
-                radius: 0.07,
-            },
+            body: pushbot_world::enclosing_circle::Circle::at_origin(0.07),
         }
     }
 
