@@ -57,6 +57,18 @@ if [ "$(grep -c . <<<"$sim_files")" -gt 3 ] || grep -v '^host/src/sim/' <<<"$sim
   echo "more host files than the built-in target's name pushbot_sim" >&2
   exit 1
 fi
+# Every dependency of the host without `sim` resolves with the features of the workspace's test
+# build (host/Cargo.toml's feature unification), so the two builds share every compiled
+# dependency; a new dependency that breaks this would compile the whole tree twice.
+features_of() { cargo tree "$@" -f '{p} [{f}]' --prefix none | sed 's/ (\*)$//' | sort -u; }
+unshared=$(comm -23 <(features_of -p pushbot --no-default-features -e normal,build) \
+  <(features_of --workspace -e normal,build,dev) | grep -v '^pushbot v' || true)
+if [ -n "$unshared" ]; then
+  echo "the host without sim resolves these dependencies with other features than the workspace:" >&2
+  echo "$unshared" >&2
+  echo "(add the missing features to host/Cargo.toml's feature unification)" >&2
+  exit 1
+fi
 cargo clippy -p pushbot --no-default-features --lib --bins -- -D warnings
 cargo build -p pushbot --no-default-features
 set +e

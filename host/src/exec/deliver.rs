@@ -371,6 +371,11 @@ pub fn deliver_learned_among(
     };
     let mut stall = StallWatch::new(p, start);
     let mut last_leg = false;
+    // Along a path the wanted motion is the enclosing circle's centre's, so the strategy is
+    // asked for the pushes that moved that point so: the samples keyed on it
+    // ([`PushStrategy::about`]). The marker's own keys serve the last leg and a clear table.
+    let body = ws.body.centre;
+    let mut about_body = (path.is_some() && body != [0.0, 0.0]).then(|| strategy.about(body));
     loop {
         let (r, o) = (io.robot_pose(), io.object_pose());
         traj.push((r, o));
@@ -437,10 +442,14 @@ pub fn deliver_learned_among(
         } else {
             step
         };
+        let keyed: &PushStrategy = match &about_body {
+            Some(b) if on_centre => b,
+            _ => strategy,
+        };
         let dir_world = if special {
             let circle = circle_of(&o);
             let Some((rep, radius)) =
-                reachable_reposition(strategy, &ws, obstacles, &o, r.position(), want, &circle)
+                reachable_reposition(keyed, &ws, obstacles, &o, r.position(), want, &circle)
             else {
                 return Ok(finish(
                     io,
@@ -469,7 +478,7 @@ pub fn deliver_learned_among(
             o.vector_to_world(Vector2::new(rep.r[0], rep.r[1]))
         } else {
             let pl = o.point_to_local(r.position());
-            let Some(rr) = strategy.general([pl.x, pl.y], want) else {
+            let Some(rr) = keyed.general([pl.x, pl.y], want) else {
                 return Ok(finish(
                     io,
                     start,
@@ -497,6 +506,9 @@ pub fn deliver_learned_among(
         // admission rule: a collection's selective sampling).
         if moved.norm() >= p.moved_epsilon && strategy.offer(sample) {
             sink(&sample)?;
+            if let Some(b) = about_body.as_mut() {
+                b.add(sample.about(body));
+            }
         }
         // Special case next when the push moved the object away from where it was wanted (the
         // goal, or the path's sub-goal) or off it by more than the re-position angle, or did

@@ -125,6 +125,15 @@ impl PushStrategy {
         self.special = Some(ImmutableKdTree::new_from_slice(&s));
     }
 
+    /// The same samples keyed on the motion of the object's point `c` (object frame) rather
+    /// than its marker's ([`Sample::about`]): asked for a wanted motion, it answers with the
+    /// pushes that moved that point so. Among obstacles the object's path is planned for its
+    /// outline's enclosing circle, whose centre is the point to move
+    /// ([`crate::exec::deliver::deliver_learned_among`]). No admission rule.
+    pub fn about(&self, c: [f64; 2]) -> PushStrategy {
+        PushStrategy::new(self.samples.iter().map(|s| s.about(c)), self.params)
+    }
+
     /// Add a sample for immediate use (non-finite samples are ignored).
     pub fn add(&mut self, s: Sample) {
         if !s.is_finite() {
@@ -438,5 +447,47 @@ mod tests {
         }
         let r = strat.general(s.p, [1.0, 0.0]).unwrap();
         assert!((r[0] - s.r[0]).abs() < 1e-12 && (r[1] - s.r[1]).abs() < 1e-12);
+    }
+
+    /// An object that turns as it is pushed: pushed from angle a, its point c goes 2.4 cm
+    /// towards a + π and it turns by 0.3 sin a, so its marker (the origin) goes another way.
+    #[test]
+    fn a_strategy_about_a_point_moves_that_point_the_wanted_way() {
+        let c = [0.0, 0.06];
+        let push = |a: f64| {
+            let d = [a.cos(), a.sin()];
+            let theta = 0.3 * a.sin();
+            let (sin, cos) = theta.sin_cos();
+            // The marker's displacement: c's less the swing of c about the marker.
+            let swing = [
+                cos * c[0] - sin * c[1] - c[0],
+                sin * c[0] + cos * c[1] - c[1],
+            ];
+            Sample {
+                p: [0.08 * d[0], 0.08 * d[1]],
+                r: [-0.03 * d[0], -0.03 * d[1]],
+                s: [-0.024 * d[0] - swing[0], -0.024 * d[1] - swing[1]],
+                theta,
+            }
+        };
+        let samples: Vec<Sample> = (0..720)
+            .map(|i| push(i as f64 * std::f64::consts::TAU / 720.0))
+            .collect();
+        let marker = PushStrategy::new(samples.iter().copied(), KernelParams::default());
+        let centre = marker.about(c);
+        let heading = |v: [f64; 2]| v[1].atan2(v[0]);
+        // How far c's motion, pushing from where the strategy stands, is off `dir`.
+        let miss = |s: &PushStrategy, dir: f64| {
+            let rep = s.special([dir.cos(), dir.sin()]).unwrap();
+            let moved = push(heading(rep.p)).about(c).s;
+            crate::strategy::sample::wrap_angle(heading(moved) - dir).abs()
+        };
+        let mut worst_marker: f64 = 0.0;
+        for dir in [0.3f64, 1.2, 1.9, 2.8, -0.8, -1.6, -2.5] {
+            assert!(miss(&centre, dir) < 0.05, "{dir}: {}", miss(&centre, dir));
+            worst_marker = worst_marker.max(miss(&marker, dir));
+        }
+        // Keyed on the marker, the same queries move the point well off the wanted way.
+        assert!(worst_marker > 0.3, "{worst_marker}");
     }
 }

@@ -50,6 +50,18 @@ impl Sample {
             .all(|v| v.is_finite())
     }
 
+    /// The same push as the motion of the object's point `c` (object frame) rather than of its
+    /// marker: `s` becomes that point's displacement, s + (R(θ) − I)·c, in the object's frame
+    /// before the push; the robot's place and motion and the rotation stay.
+    pub fn about(&self, c: [f64; 2]) -> Sample {
+        let (sin, cos) = self.theta.sin_cos();
+        let turned = [cos * c[0] - sin * c[1], sin * c[0] + cos * c[1]];
+        Sample {
+            s: [self.s[0] + turned[0] - c[0], self.s[1] + turned[1] - c[1]],
+            ..*self
+        }
+    }
+
     /// Length of the object's displacement.
     pub fn s_len(&self) -> f64 {
         self.s[0].hypot(self.s[1])
@@ -59,6 +71,7 @@ impl Sample {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector2;
     use std::f64::consts::FRAC_PI_2;
 
     #[test]
@@ -81,6 +94,30 @@ mod tests {
         );
         assert!((s.s[1] + 0.05).abs() < 1e-12);
         assert!((s.theta - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_push_about_a_point_is_that_points_displacement() {
+        // The point c (object frame) measured in the table before and after the push.
+        let c = Vector2::new(0.04, -0.06);
+        let obj0 = Pose2::new(1.0, 0.5, 0.7);
+        let obj1 = Pose2::new(1.03, 0.52, 1.1);
+        let s = Sample::from_push(
+            Pose2::new(0.9, 0.5, 0.0),
+            Pose2::new(0.95, 0.5, 0.0),
+            obj0,
+            obj1,
+        );
+        let moved = obj0.vector_to_local(obj1.point_to_world(c) - obj0.point_to_world(c));
+        let a = s.about([c.x, c.y]);
+        assert!((a.s[0] - moved.x).abs() < 1e-12 && (a.s[1] - moved.y).abs() < 1e-12);
+        // The marker moved differently: the rotation swings c round it.
+        assert!(
+            (a.s[0] - s.s[0]).hypot(a.s[1] - s.s[1]) > 0.02,
+            "{a:?} {s:?}"
+        );
+        assert_eq!((a.p, a.r, a.theta), (s.p, s.r, s.theta));
+        assert_eq!(s.about([0.0, 0.0]), s);
     }
 
     #[test]
