@@ -253,7 +253,13 @@ fn the_l_shape_goes_through_a_door_its_marker_circle_does_not_fit() {
             d.failure, d.time, d.steps, d.recoveries
         );
         assert!(d.success, "start {start}: {:?}", d.failure);
-        assert!(d.final_distance < DeliveryParams::default().success_radius);
+        // Ground truth: the marker within the success radius the camera judged it by, give or
+        // take four standard deviations of the camera's 1 mm noise.
+        let truth = (goal - io.true_object_pose().position()).norm();
+        assert!(
+            truth < DeliveryParams::default().success_radius + 0.004,
+            "start {start}: the marker ended {truth:.4} m from the goal"
+        );
         // It went through the door: the marker was seen beyond the wall.
         assert!(
             d.trajectory.iter().any(|(_, o)| o.x > 1.1),

@@ -344,8 +344,9 @@ pub fn deliver_learned(
 /// robot only where it fits and walks the bound-all circle the way the obstacles leave open.
 /// With a `path` (ending at `goal`, planned for the object's enclosing circle) the object is
 /// wanted to move its circle's centre towards the path's moving sub-goal
-/// ([`PathFollower::aim`]) rather than straight at the goal, and a stall is measured on the way
-/// left along the path.
+/// ([`PathFollower::aim`]) rather than straight at the goal, the strategy is asked about that
+/// centre's motion ([`PushStrategy::about`]), and a stall is measured on the way left along the
+/// path.
 pub fn deliver_learned_among(
     io: &mut dyn RobotIo,
     strategy: &mut PushStrategy,
