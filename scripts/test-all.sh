@@ -81,9 +81,17 @@ if [ "$code" -ne 2 ] || ! grep -q "no simulated target" <<<"$msg"; then
   exit 1
 fi
 
-if [ -x firmware/build-boards.sh ] || [ -f firmware/build-boards.sh ]; then
-  say "board firmware"
-  bash firmware/build-boards.sh
+# The board firmware builds in the background at the lowest priority while the tests compile
+# and run: the tests leave a core idle much of the time (the serial-port tests wait on a robot
+# paced at five times real time: 141 s of CPU in 115 s on two cores), and at nice 19 the build
+# takes only what they leave. Its output and its status are checked before QEMU needs its ELF.
+boards_pid=""
+if [ -f firmware/build-boards.sh ]; then
+  say "board firmware, in the background at nice 19"
+  boards_log=$(mktemp)
+  nice -n 19 bash firmware/build-boards.sh >"$boards_log" 2>&1 &
+  boards_pid=$!
+  trap 'kill "$boards_pid" 2>/dev/null || true' EXIT
 fi
 
 say "tests"
@@ -98,6 +106,18 @@ bash scripts/check-recording.sh
 # handshake, heartbeats, stall fault, link watchdog and garbage rejection. `--workspace`, not
 # `-p pushbot-tests`: the features resolve as for `cargo test --workspace` above, so the test
 # is already built (with `-p` every workspace crate compiled again, 1.5 minutes).
+if [ -n "$boards_pid" ]; then
+  say "board firmware: waiting for the background build"
+  if ! wait "$boards_pid"; then
+    cat "$boards_log" >&2
+    echo "the board firmware build failed" >&2
+    exit 1
+  fi
+  trap - EXIT
+  cat "$boards_log"
+  rm -f "$boards_log"
+fi
+
 say "firmware in QEMU"
 PUSHBOT_QEMU_ELF="$PWD/target/boards/thumbv7m-none-eabi/release/pushbot-board-qemu" \
   cargo test --workspace --test qemu -- --ignored --nocapture
