@@ -102,10 +102,6 @@ cargo test --workspace
 say "recordings, replay and the report in a browser"
 bash scripts/check-recording.sh
 
-# The firmware ELF itself in QEMU against the real host link (issue 3): the board binary's
-# handshake, heartbeats, stall fault, link watchdog and garbage rejection. `--workspace`, not
-# `-p pushbot-tests`: the features resolve as for `cargo test --workspace` above, so the test
-# is already built (with `-p` every workspace crate compiled again, 1.5 minutes).
 if [ -n "$boards_pid" ]; then
   say "board firmware: waiting for the background build"
   if ! wait "$boards_pid"; then
@@ -118,6 +114,10 @@ if [ -n "$boards_pid" ]; then
   rm -f "$boards_log"
 fi
 
+# The firmware ELF itself in QEMU against the real host link (issue 3): the board binary's
+# handshake, heartbeats, stall fault, link watchdog and garbage rejection. `--workspace`, not
+# `-p pushbot-tests`: the features resolve as for `cargo test --workspace` above, so the test
+# is already built (with `-p` every workspace crate compiled again, 1.5 minutes).
 say "firmware in QEMU"
 PUSHBOT_QEMU_ELF="$PWD/target/boards/thumbv7m-none-eabi/release/pushbot-board-qemu" \
   cargo test --workspace --test qemu -- --ignored --nocapture

@@ -54,10 +54,10 @@ impl Sample {
     /// marker: `s` becomes that point's displacement, s + (R(θ) − I)·c, in the object's frame
     /// before the push; the robot's place and motion and the rotation stay.
     pub fn about(&self, c: [f64; 2]) -> Sample {
-        let (sin, cos) = self.theta.sin_cos();
-        let turned = [cos * c[0] - sin * c[1], sin * c[0] + cos * c[1]];
+        let c = nalgebra::Vector2::new(c[0], c[1]);
+        let swing = Pose2::new(0.0, 0.0, self.theta).vector_to_world(c) - c;
         Sample {
-            s: [self.s[0] + turned[0] - c[0], self.s[1] + turned[1] - c[1]],
+            s: [self.s[0] + swing.x, self.s[1] + swing.y],
             ..*self
         }
     }
