@@ -19,7 +19,7 @@ use nalgebra::Vector2;
 
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::exec::maneuver::{Drive, Turn, WAY_POINT_ARRIVE, angle_of, circle_walk, face, go_to};
-use crate::exec::reposition::{BoundAll, reachable_reposition};
+use crate::exec::reposition::{BoundAll, Standing, reachable_reposition};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
 use crate::strategy::regression::PushStrategy;
@@ -346,7 +346,8 @@ pub fn deliver_learned(
 /// wanted to move its circle's centre towards the path's moving sub-goal
 /// ([`PathFollower::aim`]) rather than straight at the goal, the strategy is asked about that
 /// centre's motion ([`PushStrategy::about`]), and a stall is measured on the way left along the
-/// path.
+/// path. A special-case stand point whose push failed is not stood on again until a push goes
+/// the wanted way ([`Standing::failed`]).
 pub fn deliver_learned_among(
     io: &mut dyn RobotIo,
     strategy: &mut PushStrategy,
@@ -377,6 +378,9 @@ pub fn deliver_learned_among(
     // ([`PushStrategy::about`]). The marker's own keys serve the last leg and a clear table.
     let body = ws.body.centre;
     let mut about_body = (path.is_some() && body != [0.0, 0.0]).then(|| strategy.about(body));
+    // Among obstacles, the special case's stand points (object frame) whose push failed since
+    // the last push that went the wanted way: not tried again while another is reachable.
+    let mut failed: Vec<[f64; 2]> = Vec::new();
     loop {
         let (r, o) = (io.robot_pose(), io.object_pose());
         traj.push((r, o));
@@ -447,10 +451,15 @@ pub fn deliver_learned_among(
             Some(b) if on_centre => b,
             _ => strategy,
         };
+        let mut stood = None;
         let dir_world = if special {
             let circle = circle_of(&o);
+            let robot = Standing {
+                from: r.position(),
+                failed: &failed,
+            };
             let Some((rep, radius)) =
-                reachable_reposition(keyed, &ws, obstacles, &o, r.position(), want, &circle)
+                reachable_reposition(keyed, &ws, obstacles, &o, robot, want, &circle)
             else {
                 return Ok(finish(
                     io,
@@ -463,6 +472,7 @@ pub fn deliver_learned_among(
                 ));
             };
             repositions += 1;
+            stood = Some(rep.p);
             let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
             let rel = at - circle.centre;
             // The walk ends where the robot comes in to the stand point from, which the
@@ -525,6 +535,11 @@ pub fn deliver_learned_among(
         special = moved.norm() < p.moved_epsilon
             || off_by > p.reposition_angle.min(std::f64::consts::FRAC_PI_2)
             || moved.dot(&bias) < 0.0;
+        if !special {
+            failed.clear();
+        } else if let Some(at) = stood {
+            failed.push(at);
+        }
     }
 }
 

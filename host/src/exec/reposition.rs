@@ -2,8 +2,8 @@
 //! robot when there are obstacles (the end of §III-E): the learned re-positioning for the
 //! wanted direction, moved only as far as walls make it. The approach comes in closer than the
 //! bound-all circle (Fig. 3) where a wall cuts that circle, and only when no approach works is
-//! the wanted direction turned. [`crate::exec::deliver::deliver_learned_among`] walks the
-//! robot there.
+//! the wanted direction turned or a single recorded push (a sample, §III-B) stood in for the
+//! regression. [`crate::exec::deliver::deliver_learned_among`] walks the robot there.
 
 use nalgebra::Vector2;
 
@@ -11,7 +11,8 @@ use crate::exec::io::Workspace;
 use crate::exec::maneuver::around_object;
 use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
 use crate::strategy::regression::{PushStrategy, Reposition};
-use crate::strategy::sample::Pose2;
+use crate::strategy::sample::{Pose2, wrap_angle};
+use std::f64::consts::FRAC_PI_2;
 
 /// The bound-all circle (Fig. 3) the special case walks the robot round the object on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,6 +22,20 @@ pub struct BoundAll {
     /// Radius, m.
     pub radius: f64,
 }
+
+/// Where the robot is when the special case stands it somewhere, and the stand points
+/// (object frame) from which a push of this delivery moved the object neither far enough
+/// nor the wanted way since it last did: they are not tried again while others are reachable.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Standing<'a> {
+    /// The robot's position, table frame.
+    pub from: Vector2<f64>,
+    /// Stand points that failed, object frame.
+    pub failed: &'a [[f64; 2]],
+}
+
+/// A candidate stand point closer than this to one that failed counts as that one, m.
+const FAILED_STAND_RADIUS: f64 = 0.015;
 
 /// Wanted directions tried, in order, when the robot cannot stand where the special case puts
 /// it: the direction to the goal, then turned either way by up to 90°.
@@ -35,14 +50,17 @@ const SPECIAL_TURNS_DEG: [f64; 13] = [
 /// approach point around the obstacles and the object. The approach point lies on the
 /// bound-all circle where that is clear; where a wall cuts the circle there (a corridor), it
 /// comes in closer, down to [`APPROACH_GAP`] outside the stand point. When no approach works,
-/// the wanted direction is turned a little either way ([`SPECIAL_TURNS_DEG`]); the first
-/// direction that works wins, else the untouched one.
+/// or the stand point already failed ([`Standing::failed`]), the candidates are the
+/// regression's answers for the wanted direction turned either way ([`SPECIAL_TURNS_DEG`])
+/// and the recorded pushes that moved the object within 90° of it, nearest direction first;
+/// the first that works wins, else the untouched one. On a clear table it is the paper's
+/// re-positioning as it is.
 pub(crate) fn reachable_reposition(
     strategy: &PushStrategy,
     ws: &Workspace,
     obstacles: &[Vec<[f64; 2]>],
     o: &Pose2,
-    from: Vector2<f64>,
+    robot: Standing,
     want: [f64; 2],
     bound_all: &BoundAll,
 ) -> Option<(Reposition, f64)> {
@@ -51,18 +69,44 @@ pub(crate) fn reachable_reposition(
         return Some((first, bound_all.radius));
     }
     let approach_radius =
-        |rep: &Reposition| approach_radius(ws, obstacles, o, from, rep, bound_all);
-    if let Some(radius) = approach_radius(&first) {
+        |rep: &Reposition| approach_radius(ws, obstacles, o, robot.from, rep, bound_all);
+    let fresh = |rep: &Reposition| {
+        robot
+            .failed
+            .iter()
+            .all(|f| (f[0] - rep.p[0]).hypot(f[1] - rep.p[1]) > FAILED_STAND_RADIUS)
+    };
+    if fresh(&first)
+        && let Some(radius) = approach_radius(&first)
+    {
         return Some((first, radius));
     }
-    SPECIAL_TURNS_DEG[1..]
-        .iter()
-        .filter_map(|deg| {
-            let (s, c) = deg.to_radians().sin_cos();
-            strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])
+    // The regression's answer for a turned direction, or one recorded push: the regression
+    // averages the stand points of pushes that moved the object alike, and when those came
+    // from different sides (an L turned about its corner, or pushed along) the average can
+    // stand where none of them did, inside a wall. Each candidate is ranked by how far off
+    // the wanted direction its motion is; the first the robot can reach wins.
+    let want_angle = want[1].atan2(want[0]);
+    let least = SINGLE_PUSH_LEAST * strategy.offset();
+    let turned = SPECIAL_TURNS_DEG[1..].iter().filter_map(|deg| {
+        let (s, c) = deg.to_radians().sin_cos();
+        let rep = strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])?;
+        Some((deg.abs().to_radians(), rep))
+    });
+    let single = strategy.samples().iter().filter_map(|s| {
+        let off = wrap_angle(s.s[1].atan2(s.s[0]) - want_angle).abs();
+        (s.s_len() >= least && off <= FRAC_PI_2).then_some((off, Reposition { p: s.p, r: s.r }))
+    });
+    let mut candidates: Vec<(f64, Reposition)> = turned.chain(single).collect();
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    candidates
+        .into_iter()
+        .filter(|(_, rep)| fresh(rep))
+        .find_map(|(_, rep)| approach_radius(&rep).map(|radius| (rep, radius)))
+        .or_else(|| {
+            tracing::debug!("special case: no reachable stand point within 90 degrees");
+            Some((first, bound_all.radius))
         })
-        .find_map(|rep| approach_radius(&rep).map(|radius| (rep, radius)))
-        .or(Some((first, bound_all.radius)))
 }
 
 /// The radius of the circle about the bound-all circle's centre from which the robot, now at
@@ -99,6 +143,10 @@ pub(crate) fn approach_radius(
                     || plan_robot_path(ws, &around, from, approach).is_some())
         })
 }
+
+/// A recorded push stands in for the regression only when it moved the object at least this
+/// fraction of the samples' mean displacement ([`PushStrategy::offset`]).
+const SINGLE_PUSH_LEAST: f64 = 0.5;
 
 /// The closest the special case's approach comes to the object: this far outside the stand
 /// point, m.
@@ -161,8 +209,9 @@ mod tests {
             radius: bound_all,
         };
         let from = Vector2::new(0.85, 0.6);
+        let at = |from| Standing { from, failed: &[] };
         let (rep, radius) =
-            reachable_reposition(&strategy, &ws, &walls, &o, from, [1.0, 0.0], &circle)
+            reachable_reposition(&strategy, &ws, &walls, &o, at(from), [1.0, 0.0], &circle)
                 .expect("a re-positioning");
         let stand = Vector2::new(rep.p[0], rep.p[1]);
         let push = Vector2::new(rep.r[0], rep.r[1]);
@@ -182,8 +231,94 @@ mod tests {
         // On an open table the approach stays on the bound-all circle.
         let open = [vec![[0.0, 1.15], [0.05, 1.15], [0.05, 1.2]]];
         let (_, radius) =
-            reachable_reposition(&strategy, &ws, &open, &o, from, [1.0, 0.0], &circle)
+            reachable_reposition(&strategy, &ws, &open, &o, at(from), [1.0, 0.0], &circle)
                 .expect("a re-positioning");
         assert_eq!(radius, bound_all);
+    }
+
+    /// An object pressed against a wall on its left, wanted to the right. Every push the
+    /// strategy knows that moves it rightwards stands the robot on its left, in the wall, but
+    /// for three pushes from below that turned it and moved it up and to the right. The
+    /// regression (its k nearest pushes are always from the left) stands the robot in the wall
+    /// for every turned direction; the re-positioning stands it where one of the pushes from
+    /// below did. Once that stand point failed it is not offered again.
+    #[test]
+    fn against_a_wall_a_recorded_push_from_a_side_the_robot_can_reach_is_used() {
+        let ws = Workspace {
+            table: Rect {
+                min: [0.0, 0.0],
+                max: [1.6, 1.2],
+            },
+            boundary: Rect {
+                min: [0.1, 0.1],
+                max: [1.5, 1.1],
+            },
+            robot_radius: 0.04,
+            object_radius: 0.06,
+            body: pushbot_world::enclosing_circle::Circle::at_origin(0.06),
+        };
+        let walls = vec![vec![[0.6, 0.0], [0.7, 0.0], [0.7, 1.2], [0.6, 1.2]]];
+        let o = Pose2::new(0.76, 0.5, 0.0);
+        let mut samples = Vec::new();
+        // From the left, at heights −3…3 cm: the object goes right and turns, so its motion
+        // fans out over ±80°; each direction is pushed three times.
+        for k in -8..=8 {
+            let phi = (k as f64 * 10.0).to_radians();
+            for push in [0.03, 0.035, 0.04] {
+                samples.push(Sample {
+                    p: [-0.08, -0.03 * k as f64 / 8.0],
+                    r: [push, 0.0],
+                    s: [0.8 * push * phi.cos(), 0.8 * push * phi.sin()],
+                    theta: 0.0,
+                });
+            }
+        }
+        // From below, pushing up: three pushes that moved it 55° from the right, a little
+        // further than the pushes from the left moved it.
+        let below = [0.0, -0.08];
+        let phi = 55f64.to_radians();
+        for push in [0.05, 0.055, 0.06] {
+            samples.push(Sample {
+                p: below,
+                r: [0.0, push],
+                s: [0.8 * push * phi.cos(), 0.8 * push * phi.sin()],
+                theta: 0.0,
+            });
+        }
+        let strategy = PushStrategy::new(
+            samples,
+            crate::strategy::regression::KernelParams::default(),
+        );
+        let circle = BoundAll {
+            centre: o.position(),
+            radius: 0.06 + 0.08 + 0.02,
+        };
+        let from = Vector2::new(1.2, 0.2);
+        let stands_in_a_wall = |rep: &Reposition| {
+            !robot_fits(
+                &ws,
+                &walls,
+                o.point_to_world(Vector2::new(rep.p[0], rep.p[1])),
+            )
+        };
+        // The regression alone leaves the robot nowhere to stand.
+        for deg in SPECIAL_TURNS_DEG {
+            let (s, c) = deg.to_radians().sin_cos();
+            let rep = strategy.special([c, s]).expect("an answer");
+            assert!(stands_in_a_wall(&rep), "turned {deg}°: {rep:?}");
+        }
+        let robot = Standing { from, failed: &[] };
+        let (rep, _) = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
+            .expect("a re-positioning");
+        assert_eq!(rep.p, below, "{rep:?}");
+        assert!(!stands_in_a_wall(&rep));
+        // Once the stand point below failed, nothing reachable is left: the untouched answer.
+        let robot = Standing {
+            from,
+            failed: &[below],
+        };
+        let (rep, _) = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
+            .expect("a re-positioning");
+        assert_eq!(Some(rep), strategy.special([1.0, 0.0]));
     }
 }
