@@ -4,7 +4,8 @@
 //! Stalls: when the object stops coming closer to its sub-goal, the delivery detects it, backs
 //! off, plans again from where the object is and records the recovery — never a silent
 //! time-out. The stall is made real: for a while the robot's pushes do not move it (it stands,
-//! as a robot whose wheels slip on the spot).
+//! as a robot whose wheels slip on the spot). A leg where the robot can stand nowhere to push
+//! the way the path wants stalls at once.
 //!
 //! The body's path: the way is planned for the object's body, not for its marker. The
 //! L-shape's marker sits in its corner, 11.7 cm from its furthest vertex, so the circle round
@@ -266,4 +267,62 @@ fn the_l_shape_goes_through_a_door_its_marker_circle_does_not_fit() {
             "the object never passed the wall"
         );
     }
+}
+
+/// Along a path, when no stand point the robot can reach pushes the object the way the path
+/// wants, that is a stall at once, not after `stall_time` of pushing nothing: the irregular
+/// object stands 1.5 cm right of a wall, wanted off to the right, and every push the strategy
+/// knows stands the robot on its left, in the wall.
+#[test]
+fn with_nowhere_to_stand_the_leg_stalls_at_once() {
+    use pushbot::exec::deliver::deliver_learned_among;
+    use pushbot::planner::path_follow::PathFollower;
+    use pushbot::strategy::sample::Sample;
+
+    let mut scene = Scene::preset("lau-irregular").unwrap();
+    scene.obstacles = vec![Obstacle {
+        outline: vec![[0.30, 0.80], [0.36, 0.80], [0.36, 1.10], [0.30, 1.10]],
+    }];
+    let walls = scene_obstacles(&scene);
+    let mut io = SimRobot::new(scene, None, None, SimRobotOptions::default()).unwrap();
+    let (ws, o) = (io.workspace(), io.object_pose());
+    assert!(o.theta.abs() < 0.05 && (o.x - 0.45).abs() < 0.01, "{o:?}");
+    // Pushes from the left only (8 cm left of the marker, at heights ±2 cm), each moving the
+    // object right, a little up or down.
+    let samples = (-4..=4).map(|k| {
+        let y = 0.005 * f64::from(k);
+        Sample {
+            p: [-0.08, y],
+            r: [0.04, 0.0],
+            s: [0.03, -0.2 * y],
+            theta: 0.0,
+        }
+    });
+    let mut strat = PushStrategy::new(samples, KernelParams::default());
+    let goal = Vector2::new(1.25, 0.6);
+    let op = ObstacleParams::default();
+    let path = plan_object_path(&ws.body_workspace(), &walls, ws.body_centre(&o), goal, &op)
+        .expect("a path");
+    let mut follow = PathFollower::new(&path, op.lookahead).expect("a path to follow");
+    let params = DeliveryParams {
+        stall_time: op.stall_time,
+        ..DeliveryParams::default()
+    };
+    let d = deliver_learned_among(
+        &mut io,
+        &mut strat,
+        goal,
+        &params,
+        &walls,
+        Some(&mut follow),
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    assert_eq!(d.failure, Some(Failure::Stalled), "{d:?}");
+    assert!(
+        d.time < 0.1 * op.stall_time,
+        "stalled after {:.0} s",
+        d.time
+    );
+    assert_eq!(d.steps, 0, "pushed {} times", d.steps);
 }

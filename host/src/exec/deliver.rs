@@ -19,7 +19,7 @@ use nalgebra::Vector2;
 
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::exec::maneuver::{Drive, Turn, WAY_POINT_ARRIVE, angle_of, circle_walk, face, go_to};
-use crate::exec::reposition::{BoundAll, Standing, reachable_reposition};
+use crate::exec::reposition::{BoundAll, Stand, Standing, reachable_reposition};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
 use crate::strategy::regression::PushStrategy;
@@ -143,8 +143,11 @@ pub struct Delivery {
     pub object_path: f64,
     /// Path length of the robot, m.
     pub robot_path: f64,
+    /// Path length of the centre of the object's body (its outline's smallest enclosing
+    /// circle), m: the point the shortest path below is for.
+    pub body_path: f64,
     /// Length of the shortest collision-free path of the object's body (its smallest
-    /// enclosing circle) from where it started to the goal, m, when measured
+    /// enclosing circle) from where its centre started to where it ended, m, when measured
     /// ([`crate::planner::global::shortest_object_path`]).
     pub shortest_path: Option<f64>,
     /// Final marker–goal distance, m.
@@ -166,6 +169,7 @@ impl Delivery {
             recoveries: Vec::new(),
             object_path: 0.0,
             robot_path: 0.0,
+            body_path: 0.0,
             shortest_path: None,
             final_distance,
             trajectory: Vec::new(),
@@ -203,8 +207,8 @@ pub const TRACK_DEADBAND: f64 = 0.005;
 
 /// Length of the track of one body of `traj` (robot or object), measured through the camera:
 /// the polyline through the points at least [`TRACK_DEADBAND`] apart, and its last point.
-fn path_len(traj: &[(Pose2, Pose2)], pick: fn(&(Pose2, Pose2)) -> Pose2) -> f64 {
-    let mut points = traj.iter().map(|t| pick(t).position());
+fn path_len(traj: &[(Pose2, Pose2)], pick: impl Fn(&(Pose2, Pose2)) -> Vector2<f64>) -> f64 {
+    let mut points = traj.iter().map(pick);
     let Some(mut last) = points.next() else {
         return 0.0;
     };
@@ -312,6 +316,7 @@ fn finish(
     trajectory: Vec<(Pose2, Pose2)>,
 ) -> Delivery {
     let o = io.object_pose();
+    let ws = io.workspace();
     Delivery {
         success: outcome.is_ok(),
         failure: outcome.err(),
@@ -319,8 +324,9 @@ fn finish(
         steps,
         repositions,
         recoveries: Vec::new(),
-        object_path: path_len(&trajectory, |t| t.1),
-        robot_path: path_len(&trajectory, |t| t.0),
+        object_path: path_len(&trajectory, |t| t.1.position()),
+        robot_path: path_len(&trajectory, |t| t.0.position()),
+        body_path: path_len(&trajectory, |t| ws.body_centre(&t.1)),
         shortest_path: None,
         final_distance: (goal - o.position()).norm(),
         trajectory,
@@ -458,8 +464,11 @@ pub fn deliver_learned_among(
                 from: r.position(),
                 failed: &failed,
             };
-            let Some((rep, radius)) =
-                reachable_reposition(keyed, &ws, obstacles, &o, robot, want, &circle)
+            let Some(Stand {
+                rep,
+                radius,
+                reachable,
+            }) = reachable_reposition(keyed, &ws, obstacles, &o, robot, want, &circle)
             else {
                 return Ok(finish(
                     io,
@@ -471,6 +480,14 @@ pub fn deliver_learned_among(
                     traj,
                 ));
             };
+            // Along a path, no stand point the robot can reach pushes the object the way the
+            // path wants: that is a stall now, not after `stall_time` of pushing nothing (the
+            // recovery backs off, plans again and pushes the object aside).
+            if !reachable && path.is_some() {
+                tracing::debug!("no reachable stand point for the path's way: a stall");
+                let v = Err(Failure::Stalled);
+                return Ok(finish(io, start, goal, v, steps, repositions, traj));
+            }
             repositions += 1;
             stood = Some(rep.p);
             let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
@@ -628,7 +645,7 @@ mod tests {
             .windows(2)
             .map(|w| (w[1].1.position() - w[0].1.position()).norm())
             .sum();
-        let tracked = path_len(&traj, |t| t.1);
+        let tracked = path_len(&traj, |t| t.1.position());
         assert!(raw > 1.15, "raw {raw}");
         assert!((tracked - 1.0).abs() < 0.02, "tracked {tracked}");
         // A still body watched 500 times: its noise alone would be most of a metre; tracked,
@@ -643,11 +660,11 @@ mod tests {
             .windows(2)
             .map(|w| (w[1].1.position() - w[0].1.position()).norm())
             .sum();
-        let tracked_still = path_len(&still, |t| t.1);
+        let tracked_still = path_len(&still, |t| t.1.position());
         assert!(
             raw_still > 0.5 && tracked_still < 0.05,
             "{raw_still} {tracked_still}"
         );
-        assert_eq!(path_len(&[], |t| t.1), 0.0);
+        assert_eq!(path_len(&[], |t| t.1.position()), 0.0);
     }
 }

@@ -18,7 +18,7 @@ use crate::exec::deliver::{
     Delivery, DeliveryParams, Failure, Recovery, bound_all_circle, deliver_learned_among,
 };
 use crate::exec::io::RobotIo;
-use crate::exec::reposition::{BoundAll, approach_radius};
+use crate::exec::reposition::{BoundAll, approach_radius, recorded_pushes};
 use crate::planner::global::{ObstacleParams, clearance, plan_object_path};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::regression::PushStrategy;
@@ -174,6 +174,7 @@ fn add_leg(all: &mut Delivery, d: Delivery) {
     all.repositions += d.repositions;
     all.object_path += d.object_path;
     all.robot_path += d.robot_path;
+    all.body_path += d.body_path;
     all.trajectory.extend(d.trajectory);
 }
 
@@ -193,9 +194,14 @@ fn back_off(io: &mut dyn RobotIo, op: &ObstacleParams) -> Result<()> {
 /// How far a recovery pushes the object aside, m.
 const SIDE_STEP: f64 = 0.08;
 
+/// A recorded push counts for a direction aside when it moved the object within this of it,
+/// rad (the sixteen directions are 22.5° apart).
+const SIDE_STEP_OFF: f64 = 0.2;
+
 /// Where to push the object's marker when it stalled while wanted along `want`: of sixteen
-/// directions, those for which the learned special case (Algorithm 2) stands the robot where
-/// it fits and can get to from where it is ([`approach_radius`]) and the object's enclosing
+/// directions, those for which the learned special case (Algorithm 2), or a recorded push that
+/// moved the object that way ([`recorded_pushes`]), stands the robot where it fits and can get
+/// to from where it is ([`approach_radius`]) and the object's enclosing
 /// circle ends no closer to an obstacle than its clearance (or than it is now), the one
 /// nearest to `want`.
 fn side_step(
@@ -222,9 +228,13 @@ fn side_step(
             let local = o.vector_to_local(*d);
             ws.boundary.contains(o.position() + d * SIDE_STEP)
                 && clearance(t, obstacles) >= keep
-                && strategy.special([local.x, local.y]).is_some_and(|rep| {
-                    approach_radius(ws, obstacles, o, from, &rep, bound_all).is_some()
-                })
+                && strategy
+                    .special([local.x, local.y])
+                    .into_iter()
+                    .chain(
+                        recorded_pushes(strategy, [local.x, local.y], SIDE_STEP_OFF).map(|c| c.1),
+                    )
+                    .any(|rep| approach_radius(ws, obstacles, o, from, &rep, bound_all).is_some())
         })
         .max_by(|a, b| a.dot(&want).total_cmp(&b.dot(&want)))
         .map(|d| o.position() + d * SIDE_STEP)

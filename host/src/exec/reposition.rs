@@ -63,10 +63,15 @@ pub(crate) fn reachable_reposition(
     robot: Standing,
     want: [f64; 2],
     bound_all: &BoundAll,
-) -> Option<(Reposition, f64)> {
+) -> Option<Stand> {
     let first = strategy.special(want)?;
+    let stand = |rep, radius| Stand {
+        rep,
+        radius,
+        reachable: true,
+    };
     if obstacles.is_empty() {
-        return Some((first, bound_all.radius));
+        return Some(stand(first, bound_all.radius));
     }
     let approach_radius =
         |rep: &Reposition| approach_radius(ws, obstacles, o, robot.from, rep, bound_all);
@@ -79,34 +84,62 @@ pub(crate) fn reachable_reposition(
     if fresh(&first)
         && let Some(radius) = approach_radius(&first)
     {
-        return Some((first, radius));
+        return Some(stand(first, radius));
     }
     // The regression's answer for a turned direction, or one recorded push: the regression
     // averages the stand points of pushes that moved the object alike, and when those came
     // from different sides (an L turned about its corner, or pushed along) the average can
     // stand where none of them did, inside a wall. Each candidate is ranked by how far off
     // the wanted direction its motion is; the first the robot can reach wins.
-    let want_angle = want[1].atan2(want[0]);
-    let least = SINGLE_PUSH_LEAST * strategy.offset();
     let turned = SPECIAL_TURNS_DEG[1..].iter().filter_map(|deg| {
         let (s, c) = deg.to_radians().sin_cos();
         let rep = strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])?;
         Some((deg.abs().to_radians(), rep))
     });
-    let single = strategy.samples().iter().filter_map(|s| {
-        let off = wrap_angle(s.s[1].atan2(s.s[0]) - want_angle).abs();
-        (s.s_len() >= least && off <= FRAC_PI_2).then_some((off, Reposition { p: s.p, r: s.r }))
-    });
-    let mut candidates: Vec<(f64, Reposition)> = turned.chain(single).collect();
+    let mut candidates: Vec<(f64, Reposition)> = turned
+        .chain(recorded_pushes(strategy, want, FRAC_PI_2))
+        .collect();
     candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
     candidates
         .into_iter()
         .filter(|(_, rep)| fresh(rep))
-        .find_map(|(_, rep)| approach_radius(&rep).map(|radius| (rep, radius)))
+        .find_map(|(_, rep)| approach_radius(&rep).map(|radius| stand(rep, radius)))
         .or_else(|| {
             tracing::debug!("special case: no reachable stand point within 90 degrees");
-            Some((first, bound_all.radius))
+            Some(Stand {
+                rep: first,
+                radius: bound_all.radius,
+                reachable: false,
+            })
         })
+}
+
+/// The special case's answer ([`reachable_reposition`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Stand {
+    /// Where to stand and how to push, object frame.
+    pub rep: Reposition,
+    /// Radius of the circle about the bound-all circle's centre the robot comes in from, m.
+    pub radius: f64,
+    /// Whether the robot can stand there and get to it; `false` only among obstacles, when
+    /// no candidate within 90° of the wanted direction is reachable (the untouched answer).
+    pub reachable: bool,
+}
+
+/// The recorded pushes (samples) that moved the object within `max_off` of `want` (object
+/// frame) and at least [`SINGLE_PUSH_LEAST`] of the mean distance, with how far off they
+/// moved it, rad.
+pub(crate) fn recorded_pushes(
+    strategy: &PushStrategy,
+    want: [f64; 2],
+    max_off: f64,
+) -> impl Iterator<Item = (f64, Reposition)> + '_ {
+    let want_angle = want[1].atan2(want[0]);
+    let least = SINGLE_PUSH_LEAST * strategy.offset();
+    strategy.samples().iter().filter_map(move |s| {
+        let off = wrap_angle(s.s[1].atan2(s.s[0]) - want_angle).abs();
+        (s.s_len() >= least && off <= max_off).then_some((off, Reposition { p: s.p, r: s.r }))
+    })
 }
 
 /// The radius of the circle about the bound-all circle's centre from which the robot, now at
@@ -160,6 +193,24 @@ mod tests {
     use crate::exec::maneuver::angle_of;
     use crate::strategy::sample::Sample;
 
+    /// Lau et al.'s 1.6 × 1.2 m table with its boundary 0.1 m in, a robot of 4 cm radius and
+    /// a round object of `radius` about its marker.
+    fn lau_table(radius: f64) -> Workspace {
+        Workspace {
+            table: Rect {
+                min: [0.0, 0.0],
+                max: [1.6, 1.2],
+            },
+            boundary: Rect {
+                min: [0.1, 0.1],
+                max: [1.5, 1.1],
+            },
+            robot_radius: 0.04,
+            object_radius: radius,
+            body: pushbot_world::enclosing_circle::Circle::at_origin(radius),
+        }
+    }
+
     /// A disc-like strategy: pushing from angle a (8 cm out) moves the object towards a + π.
     fn disc_strategy() -> PushStrategy {
         let samples = (0..720).map(|k| {
@@ -184,19 +235,7 @@ mod tests {
     /// and pushes the way wanted, not a direction turned away from it.
     #[test]
     fn in_a_corridor_the_approach_comes_closer_than_the_bound_all_circle() {
-        let ws = Workspace {
-            table: Rect {
-                min: [0.0, 0.0],
-                max: [1.6, 1.2],
-            },
-            boundary: Rect {
-                min: [0.1, 0.1],
-                max: [1.5, 1.1],
-            },
-            robot_radius: 0.04,
-            object_radius: 0.117,
-            body: pushbot_world::enclosing_circle::Circle::at_origin(0.117),
-        };
+        let ws = lau_table(0.117);
         let walls = vec![
             vec![[0.6, 0.0], [0.7, 0.0], [0.7, 0.8], [0.6, 0.8]],
             vec![[1.0, 0.4], [1.1, 0.4], [1.1, 1.2], [1.0, 1.2]],
@@ -210,7 +249,7 @@ mod tests {
         };
         let from = Vector2::new(0.85, 0.6);
         let at = |from| Standing { from, failed: &[] };
-        let (rep, radius) =
+        let Stand { rep, radius, .. } =
             reachable_reposition(&strategy, &ws, &walls, &o, at(from), [1.0, 0.0], &circle)
                 .expect("a re-positioning");
         let stand = Vector2::new(rep.p[0], rep.p[1]);
@@ -230,7 +269,7 @@ mod tests {
         ));
         // On an open table the approach stays on the bound-all circle.
         let open = [vec![[0.0, 1.15], [0.05, 1.15], [0.05, 1.2]]];
-        let (_, radius) =
+        let Stand { radius, .. } =
             reachable_reposition(&strategy, &ws, &open, &o, at(from), [1.0, 0.0], &circle)
                 .expect("a re-positioning");
         assert_eq!(radius, bound_all);
@@ -244,19 +283,7 @@ mod tests {
     /// below did. Once that stand point failed it is not offered again.
     #[test]
     fn against_a_wall_a_recorded_push_from_a_side_the_robot_can_reach_is_used() {
-        let ws = Workspace {
-            table: Rect {
-                min: [0.0, 0.0],
-                max: [1.6, 1.2],
-            },
-            boundary: Rect {
-                min: [0.1, 0.1],
-                max: [1.5, 1.1],
-            },
-            robot_radius: 0.04,
-            object_radius: 0.06,
-            body: pushbot_world::enclosing_circle::Circle::at_origin(0.06),
-        };
+        let ws = lau_table(0.06);
         let walls = vec![vec![[0.6, 0.0], [0.7, 0.0], [0.7, 1.2], [0.6, 1.2]]];
         let o = Pose2::new(0.76, 0.5, 0.0);
         let mut samples = Vec::new();
@@ -308,17 +335,19 @@ mod tests {
             assert!(stands_in_a_wall(&rep), "turned {deg}°: {rep:?}");
         }
         let robot = Standing { from, failed: &[] };
-        let (rep, _) = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
+        let stand = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
             .expect("a re-positioning");
-        assert_eq!(rep.p, below, "{rep:?}");
-        assert!(!stands_in_a_wall(&rep));
-        // Once the stand point below failed, nothing reachable is left: the untouched answer.
+        assert_eq!(stand.rep.p, below, "{stand:?}");
+        assert!(stand.reachable && !stands_in_a_wall(&stand.rep));
+        // Once the stand point below failed, nothing reachable is left: the untouched answer,
+        // marked as not reachable.
         let robot = Standing {
             from,
             failed: &[below],
         };
-        let (rep, _) = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
+        let stand = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
             .expect("a re-positioning");
-        assert_eq!(Some(rep), strategy.special([1.0, 0.0]));
+        assert!(!stand.reachable, "{stand:?}");
+        assert_eq!(Some(stand.rep), strategy.special([1.0, 0.0]));
     }
 }

@@ -101,15 +101,21 @@ pub fn run_start(
         }
         let obstacles = scene_obstacles(&setup.scene);
         // The yardstick is the shortest path of the outline's smallest enclosing circle (the
-        // outline turning freely), from where its centre starts.
-        let shortest = shortest_object_path(
-            &ws.body_workspace(),
-            &obstacles,
-            ws.body_centre(&o),
-            goal,
-            &ObstacleParams::default(),
-        )
-        .map(|p| path_length(&p));
+        // outline turning freely), from where its centre starts to where it ends (the goal is
+        // the marker's; for an object marked off its middle the centre ends up to that far
+        // from it, either side). Where the end is not clear of the walls for the circle (the
+        // object lies against one) the path to the goal stands in.
+        let from = ws.body_centre(&o);
+        let shortest_to = |to| {
+            shortest_object_path(
+                &ws.body_workspace(),
+                &obstacles,
+                from,
+                to,
+                &ObstacleParams::default(),
+            )
+            .map(|p| path_length(&p))
+        };
         let delivered = match method {
             Method::Learned if !setup.scene.obstacles.is_empty() => {
                 let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
@@ -142,7 +148,12 @@ pub fn run_start(
                 lost_delivery(&io, goal)
             }
         };
-        d.shortest_path = shortest;
+        d.shortest_path = if d.success {
+            let end = ws.body_centre(&io.object_pose());
+            shortest_to(end).or_else(|| shortest_to(goal))
+        } else {
+            shortest_to(goal)
+        };
         runs.push(d);
     }
     Ok((summarise(start, method, &runs), runs))

@@ -35,8 +35,9 @@ pub struct StartResult {
     pub mean_object_path_m: Option<f64>,
     /// Mean robot path length of the successful trials, m.
     pub mean_robot_path_m: Option<f64>,
-    /// Mean, over the successful trials, of the object's path length over the shortest
-    /// collision-free path of its marker from its start to the goal.
+    /// Mean, over the successful trials, of the path length of the object's body (the centre
+    /// of its outline's smallest enclosing circle) over the shortest collision-free path of
+    /// that circle from where it started to where it ended.
     pub mean_path_ratio: Option<f64>,
     /// Largest of those ratios.
     pub max_path_ratio: Option<f64>,
@@ -62,7 +63,7 @@ pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult 
         .filter_map(|d| {
             d.shortest_path
                 .filter(|s| *s > 0.01)
-                .map(|s| d.object_path / s)
+                .map(|s| d.body_path / s)
         })
         .collect();
     let mut failures = BTreeMap::new();
@@ -150,7 +151,9 @@ mod tests {
                     action: "back off and re-plan".into(),
                 })
                 .collect(),
-            object_path: 1.2,
+            // The marker swung further than the body's centre went: the ratio is the body's.
+            object_path: 1.5,
+            body_path: 1.2,
             robot_path: 2.0,
             shortest_path: Some(1.0),
             final_distance: 0.01,
