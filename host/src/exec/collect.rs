@@ -199,6 +199,7 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             io,
             o.position(),
             radius,
+            radius,
             push_angle,
             &Drive::two_level(0.05),
             &[],
@@ -382,6 +383,7 @@ fn coverage_push(
     circle_walk(
         io,
         o.position(),
+        radius,
         radius,
         stand_angle,
         &Drive::two_level(0.05),

@@ -498,6 +498,7 @@ pub fn deliver_learned_among(
                 io,
                 circle.centre,
                 radius,
+                circle.radius,
                 angle_of(rel),
                 &Drive::one_leg(WAY_POINT_ARRIVE),
                 obstacles,

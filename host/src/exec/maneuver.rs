@@ -193,10 +193,14 @@ pub fn transit(
 /// robot cannot reach are pulled back onto the table). The walk's end is driven to as `end`
 /// says; the points on the way, which need no precision (each chord starts from a fresh
 /// measurement), with one leg each ([`Drive::one_leg`], within [`WAY_POINT_ARRIVE`]).
+/// Where a wall made the end come in closer than the bound-all circle (`radius` < `outer`),
+/// the points on the way stay as far out as `outer` where the robot fits there: a walk at the
+/// closer radius would sweep through the object.
 pub fn circle_walk(
     io: &mut dyn RobotIo,
     centre: Vector2<f64>,
     radius: f64,
+    outer: f64,
     to: f64,
     end: &Drive,
     obstacles: &[Vec<[f64; 2]>],
@@ -209,7 +213,16 @@ pub fn circle_walk(
             p.y.clamp(reach.min[1], reach.max[1]),
         )
     };
-    let on = |a: f64| centre + radius * Vector2::new(a.cos(), a.sin());
+    let at = |a: f64, r: f64| centre + r * Vector2::new(a.cos(), a.sin());
+    let on = |a: f64| at(a, radius);
+    // As far out as `outer` where the robot fits, in 1 cm steps; else on the circle.
+    let wide = |a: f64| {
+        let steps = ((outer - radius) / 0.01).ceil().max(0.0) as usize;
+        (0..=steps)
+            .map(|k| at(a, (outer - 0.01 * k as f64).max(radius)))
+            .find(|p| robot_fits(&ws, obstacles, *p))
+            .unwrap_or_else(|| on(a))
+    };
     let r = io.robot_pose();
     let rel = r.position() - centre;
     let from = if rel.norm() > 1e-9 {
@@ -227,7 +240,7 @@ pub fn circle_walk(
     if inside {
         // Back straight away from the centre onto the circle.
         face(io, angle_of(-rel), &end.turn)?;
-        let back = clamp(on(from)) - io.robot_pose().position();
+        let back = clamp(wide(from)) - io.robot_pose().position();
         io.forward(-back.norm())?;
     }
     if cut {
@@ -235,7 +248,7 @@ pub fn circle_walk(
     }
     if !inside {
         // From afar, around the obstacles and the object itself.
-        transit(io, clamp(on(from)), &around, &way)?;
+        transit(io, clamp(wide(from)), &around, &way)?;
     }
     let (a, b) = circle_routes(from, to);
     let blocked = |pts: &[f64]| {
@@ -246,7 +259,11 @@ pub fn circle_walk(
     let pts = if blocked(&a) <= blocked(&b) { a } else { b };
     let last = pts.len().saturating_sub(1);
     for (k, ang) in pts.into_iter().enumerate() {
-        go_to(io, clamp(on(ang)), if k == last { end } else { &way })?;
+        if k == last {
+            go_to(io, clamp(on(ang)), end)?;
+        } else {
+            go_to(io, clamp(wide(ang)), &way)?;
+        }
     }
     Ok(())
 }
@@ -369,6 +386,8 @@ mod tests {
     struct Short {
         pose: Pose2,
         drives: usize,
+        /// Where each drive ended.
+        track: Vec<Vector2<f64>>,
     }
 
     impl RobotIo for Short {
@@ -381,6 +400,7 @@ mod tests {
             self.pose.x += 0.9 * distance * c;
             self.pose.y += 0.9 * distance * s;
             self.drives += 1;
+            self.track.push(self.pose.position());
             Ok(())
         }
         fn drive(&mut self, _: f64, _: f64, _: f64) -> Result<()> {
@@ -413,12 +433,40 @@ mod tests {
         let mut io = Short {
             pose: Pose2::new(0.85 + 0.185, 0.5, std::f64::consts::PI),
             drives: 0,
+            track: Vec::new(),
         };
         let end = Drive::two_level(0.05);
-        circle_walk(&mut io, c, 0.155, std::f64::consts::PI, &end, &[]).unwrap();
+        circle_walk(&mut io, c, 0.155, 0.155, std::f64::consts::PI, &end, &[]).unwrap();
         let target = c - Vector2::new(0.155, 0.0);
         let miss = (io.pose.position() - target).norm();
         assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
         assert_eq!(io.drives, 1 + 5 + 2, "drives");
+    }
+
+    /// A walk whose end comes in to 10 cm of the object (a wall cut the bound-all circle of
+    /// 15.5 cm there) goes round at 15.5 cm wherever the robot fits, and only its end comes
+    /// in: at 10 cm all the way round it would sweep through the object.
+    #[test]
+    fn a_walk_that_ends_closer_goes_round_at_the_bound_all_circle() {
+        let c = Vector2::new(0.85, 0.5);
+        let mut io = Short {
+            pose: Pose2::new(0.85 + 0.185, 0.5, std::f64::consts::PI),
+            drives: 0,
+            track: Vec::new(),
+        };
+        let end = Drive::two_level(0.05);
+        circle_walk(&mut io, c, 0.10, 0.155, std::f64::consts::PI, &end, &[]).unwrap();
+        let target = c - Vector2::new(0.10, 0.0);
+        let miss = (io.pose.position() - target).norm();
+        assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
+        // Every drive but the end's two legs ended 15.5 cm out, give or take the 10 %
+        // shortfall of a chord.
+        let (way, last) = io.track.split_at(io.track.len() - 2);
+        assert!(way.len() >= 5, "{:?}", io.track);
+        for p in way {
+            let d = (p - c).norm();
+            assert!(d > 0.14, "a way point {d:.3} m from the object");
+        }
+        assert!(last.iter().all(|p| (p - c).norm() < 0.12), "{last:?}");
     }
 }
