@@ -8,7 +8,7 @@
 //!   their test layout (Fig. 10): a bounded table, start positions `A`–`F` (the object starts
 //!   at `A`), one goal. `lau-obstacles`: the irregular object's layout with a wall between
 //!   start and goal (delivery among obstacles, §III-E); `lau-door`, `lau-zigzag` (and `-l`, the
-//!   L-shape): a wall with a 0.3 m door, two staggered walls.
+//!   L-shape, as `lau-obstacles-l`): a wall with a 0.3 m door, two staggered walls.
 //! * `bsr-a` … `bsr-d` — Ben-Shahar & Rivlin's test cases A–D: boxes in rooms joined by doors
 //!   (A: two boxes to move to the other room; B: two boxes to exchange in a corridor; C: a
 //!   complex (U-shaped) movable through a door; D: an L-shaped movable in a cluttered room),
@@ -33,6 +33,7 @@ pub const NAMES: &[&str] = &[
     "lau-scissors",
     "lau-snake",
     "lau-obstacles",
+    "lau-obstacles-l",
     "lau-door",
     "lau-door-l",
     "lau-zigzag",
@@ -88,6 +89,13 @@ pub fn text(name: &str) -> Option<String> {
         // wall's start side, 0.2 m right of A.
         "lau-obstacles" => {
             lau(name, IRREGULAR, [0.0, 0.0], 0.15, SUPPORT_UNIFORM).replace(
+                "pose = { x = 0.85, y = 0.95, theta = -1.5708 }",
+                "pose = { x = 0.65, y = 0.95, theta = -1.5708 }",
+            ) + &obstacle(7.8, 5.5, 8.8, 12.0)
+        }
+        // The same wall with the L-shape.
+        "lau-obstacles-l" => {
+            lau(name, L_SHAPE, [-0.04, -0.035], 0.2, SUPPORT_UNIFORM).replace(
                 "pose = { x = 0.85, y = 0.95, theta = -1.5708 }",
                 "pose = { x = 0.65, y = 0.95, theta = -1.5708 }",
             ) + &obstacle(7.8, 5.5, 8.8, 12.0)

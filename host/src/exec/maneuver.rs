@@ -410,7 +410,7 @@ mod tests {
             self.pose
         }
         fn object_pose(&mut self) -> Pose2 {
-            Pose2::new(0.85, 0.5, 0.0)
+            Pose2::new(C.x, C.y, 0.0)
         }
         fn body_pose(&mut self, _: &str) -> Option<Pose2> {
             None
@@ -423,23 +423,33 @@ mod tests {
         }
     }
 
+    /// The object's centre in the walks below.
+    const C: Vector2<f64> = Vector2::new(0.85, 0.5);
+
+    /// A walk from 3 cm outside the 15.5 cm circle about [`C`], from its right half way round
+    /// to the left, ending `radius` from `C` (way points out to `outer`), driven by [`Short`];
+    /// checks the end is reached within the end's tolerance.
+    fn walk_half_round(radius: f64, outer: f64) -> Short {
+        let mut io = Short {
+            pose: Pose2::new(C.x + 0.185, C.y, std::f64::consts::PI),
+            drives: 0,
+            track: Vec::new(),
+        };
+        let end = Drive::two_level(0.05);
+        circle_walk(&mut io, C, radius, outer, std::f64::consts::PI, &end, &[]).unwrap();
+        let target = C - Vector2::new(radius, 0.0);
+        let miss = (io.pose.position() - target).norm();
+        assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
+        io
+    }
+
     /// From 3 cm outside the circle half way round: onto the circle and five way points, each
     /// one turn and one drive (a second leg would correct the 10 % shortfall, about 8 mm,
     /// which a way point does not need), and the end driven to as asked: two legs of the
     /// paper's two levels, ending within 5 mm.
     #[test]
     fn a_walk_drives_each_way_point_once_and_its_end_as_asked() {
-        let c = Vector2::new(0.85, 0.5);
-        let mut io = Short {
-            pose: Pose2::new(0.85 + 0.185, 0.5, std::f64::consts::PI),
-            drives: 0,
-            track: Vec::new(),
-        };
-        let end = Drive::two_level(0.05);
-        circle_walk(&mut io, c, 0.155, 0.155, std::f64::consts::PI, &end, &[]).unwrap();
-        let target = c - Vector2::new(0.155, 0.0);
-        let miss = (io.pose.position() - target).norm();
-        assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
+        let io = walk_half_round(0.155, 0.155);
         assert_eq!(io.drives, 1 + 5 + 2, "drives");
     }
 
@@ -448,25 +458,15 @@ mod tests {
     /// in: at 10 cm all the way round it would sweep through the object.
     #[test]
     fn a_walk_that_ends_closer_goes_round_at_the_bound_all_circle() {
-        let c = Vector2::new(0.85, 0.5);
-        let mut io = Short {
-            pose: Pose2::new(0.85 + 0.185, 0.5, std::f64::consts::PI),
-            drives: 0,
-            track: Vec::new(),
-        };
-        let end = Drive::two_level(0.05);
-        circle_walk(&mut io, c, 0.10, 0.155, std::f64::consts::PI, &end, &[]).unwrap();
-        let target = c - Vector2::new(0.10, 0.0);
-        let miss = (io.pose.position() - target).norm();
-        assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
+        let io = walk_half_round(0.10, 0.155);
         // Every drive but the end's two legs ended 15.5 cm out, give or take the 10 %
         // shortfall of a chord.
         let (way, last) = io.track.split_at(io.track.len() - 2);
         assert!(way.len() >= 5, "{:?}", io.track);
         for p in way {
-            let d = (p - c).norm();
+            let d = (p - C).norm();
             assert!(d > 0.14, "a way point {d:.3} m from the object");
         }
-        assert!(last.iter().all(|p| (p - c).norm() < 0.12), "{last:?}");
+        assert!(last.iter().all(|p| (p - C).norm() < 0.12), "{last:?}");
     }
 }
