@@ -148,11 +148,11 @@ pub fn run_start(
                 lost_delivery(&io, goal)
             }
         };
-        d.shortest_path = if d.success {
-            let end = ws.body_centre(&io.object_pose());
-            shortest_to(end).or_else(|| shortest_to(goal))
-        } else {
-            shortest_to(goal)
+        // The end is the last pose of the track the body's path was measured on (no new look).
+        let end = d.trajectory.last().map(|(_, o)| ws.body_centre(o));
+        d.shortest_path = match end {
+            Some(end) if d.success => shortest_to(end).or_else(|| shortest_to(goal)),
+            _ => shortest_to(goal),
         };
         runs.push(d);
     }
