@@ -154,6 +154,15 @@ pub fn run_start(
             Some(end) if d.success => shortest_to(end).or_else(|| shortest_to(goal)),
             _ => shortest_to(goal),
         };
+        tracing::debug!(
+            "start {start}, trial {t}: delivered {}, {:.1} s, body path {:.3} m, shortest {:.3} m, {} recoveries, {} re-positionings",
+            d.success,
+            d.time,
+            d.body_path,
+            d.shortest_path.unwrap_or(f64::NAN),
+            d.recoveries.len(),
+            d.repositions
+        );
         runs.push(d);
     }
     Ok((summarise(start, method, &runs), runs))
