@@ -431,7 +431,9 @@ fn outside(io: &mut dyn RobotIo) -> bool {
     !ws.boundary.contains(io.object_pose().position())
 }
 
-fn random_goal(io: &mut dyn RobotIo, rng: &mut ChaCha8Rng, min_dist: f64) -> Vector2<f64> {
+/// A random goal inside the boundary at least `min_dist` from the object's marker (the
+/// last of 100 draws otherwise), and its distance from the marker.
+fn random_goal(io: &mut dyn RobotIo, rng: &mut ChaCha8Rng, min_dist: f64) -> (Vector2<f64>, f64) {
     let ws = io.workspace();
     let area = ws.boundary.inset(0.05);
     let o = io.object_pose().position();
@@ -446,7 +448,7 @@ fn random_goal(io: &mut dyn RobotIo, rng: &mut ChaCha8Rng, min_dist: f64) -> Vec
             break;
         }
     }
-    best
+    (best, (best - o).norm())
 }
 
 fn progress(pb: &ProgressBar, strategy: &PushStrategy, rep: &CollectReport, t: f64) {
@@ -546,7 +548,7 @@ pub fn collect(
         if outside(io) {
             rep.boundary_resets += bring_inside(io, margin, params.epsilon)?;
         }
-        let goal = random_goal(io, &mut rng, params.goal_min_distance);
+        let (goal, distance) = random_goal(io, &mut rng, params.goal_min_distance);
         tracing::debug!(
             "evaluation query {}: goal ({:.3}, {:.3}), {:.0} s",
             rep.queries,
@@ -559,6 +561,15 @@ pub fn collect(
             added += 1;
             sink(s)
         })?;
+        tracing::debug!(
+            "evaluation query {}: delivered {} in {:.1} s, {:.3} m from the goal, object path \
+             {:.3} m",
+            rep.queries,
+            d.success,
+            d.time,
+            distance,
+            d.object_path
+        );
         rep.supplemental_samples += added;
         rep.evaluation_pushes += d.steps;
         rep.queries += 1;

@@ -155,13 +155,15 @@ pub fn run_start(
             _ => shortest_to(goal),
         };
         tracing::debug!(
-            "start {start}, trial {t}: delivered {}, {:.1} s, body path {:.3} m, shortest {:.3} m, {} recoveries, {} re-positionings",
+            "start {start}, trial {t}: delivered {}, {:.1} s, body path {:.3} m, shortest {:.3} m, {} recoveries, {} re-positionings, {} camera frames, {} looks again",
             d.success,
             d.time,
             d.body_path,
             d.shortest_path.unwrap_or(f64::NAN),
             d.recoveries.len(),
-            d.repositions
+            d.repositions,
+            io.camera_frames(),
+            io.relooks()
         );
         runs.push(d);
     }
