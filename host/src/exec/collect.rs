@@ -562,7 +562,7 @@ pub fn collect(
             sink(s)
         })?;
         tracing::debug!(
-            "evaluation query {}: delivered {} in {:.1} s, {:.3} m from the goal, object path \
+            "evaluation query {}: delivered {} in {:.1} s, from {:.3} m off the goal, object path \
              {:.3} m",
             rep.queries,
             d.success,
