@@ -153,6 +153,12 @@ fn ray_errors_px(est: &Intrinsics, truth: &Intrinsics) -> Vec<f64> {
     e
 }
 
+/// The median of [`ray_errors_px`]: how well the lens is known where the board was seen.
+fn median_ray_px(est: &Intrinsics, truth: &Intrinsics) -> f64 {
+    let e = ray_errors_px(est, truth);
+    e.get(e.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 /// The largest of [`ray_errors_px`].
 fn worst_ray_px(est: &Intrinsics, truth: &Intrinsics) -> f64 {
     ray_errors_px(est, truth)
@@ -177,8 +183,9 @@ fn a_webcam_lens_is_recovered_from_rendered_board_views() {
     let fit = collected.fit(4).unwrap();
     let l = fit.intrinsics;
     let ray = worst_ray_px(&l, &truth);
+    let median = median_ray_px(&l, &truth);
     eprintln!(
-        "fit: fx {:.2} fy {:.2} cx {:.2} cy {:.2} {:?}; RMS {:.3} px, max {:.3} px, coverage {:.2}, {} views, {} points, {} evaluations; worst ray {ray:.3} px",
+        "fit: fx {:.2} fy {:.2} cx {:.2} cy {:.2} {:?}; RMS {:.3} px, max {:.3} px, coverage {:.2}, {} views, {} points, {} evaluations; rays median {median:.3}, worst {ray:.3} px",
         l.fx,
         l.fy,
         l.cx,
@@ -196,7 +203,13 @@ fn a_webcam_lens_is_recovered_from_rendered_board_views() {
     assert!((l.cx - truth.cx).abs() < 4.0, "cx {}", l.cx);
     assert!((l.cy - truth.cy).abs() < 4.0, "cy {}", l.cy);
     assert!(fit.rms_px < 0.5, "RMS {}", fit.rms_px);
-    assert!(ray < 0.5, "undistorted rays {ray} px off the truth");
+    // Over eight noise seeds (`measure_over_seeds`): median 0.05–0.35 px, worst (the image's
+    // very corners, beyond the board's last corner) 0.14–0.69 px.
+    assert!(
+        median < 0.4,
+        "undistorted rays {median} px off the truth (median)"
+    );
+    assert!(ray < 1.0, "undistorted rays {ray} px off the truth (worst)");
     assert_eq!(fit.refusal(&Requirements::default()), None);
     // Without the distortion the same lens is a pixel or more off at the image's edges.
     let pinhole = Intrinsics {
@@ -287,7 +300,8 @@ fn calibrate_lens_writes_an_intrinsics_file_that_reads_back() {
         let truth = webcam();
         assert_eq!((l.width, l.height), (960, 720));
         assert!((l.fx / truth.fx - 1.0).abs() < 0.01, "{l:?}");
-        assert!(worst_ray_px(&l, &truth) < 0.5, "{l:?}");
+        assert!(median_ray_px(&l, &truth) < 0.4, "{l:?}");
+        assert!(worst_ray_px(&l, &truth) < 1.0, "{l:?}");
     }
     // Frames of another size in the folder: bad input, naming the frame.
     image::GrayImage::new(640, 480)

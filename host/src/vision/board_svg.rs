@@ -58,26 +58,14 @@ pub fn board_svg(board: &BoardLayout) -> Result<String, String> {
         let y0 = MARGIN_MM + bh - tag.centre[1] * 1e3 - tw as f64 / 2.0 * cell;
         let mut g = Element::new("g");
         g.assign("id", format!("tag{}", tag.id));
-        for row in 0..tw {
-            // Runs of black cells as one rectangle each.
-            let mut col = 0;
-            while col < tw {
-                if pattern[row * tw + col] {
-                    col += 1;
-                    continue;
-                }
-                let start = col;
-                while col < tw && !pattern[row * tw + col] {
-                    col += 1;
-                }
-                g.append(rect(
-                    x0 + start as f64 * cell,
-                    y0 + row as f64 * cell,
-                    (col - start) as f64 * cell,
-                    cell,
-                    "black",
-                ));
-            }
+        for (row, start, end) in TagCodes::black_runs(&pattern, tw) {
+            g.append(rect(
+                x0 + start as f64 * cell,
+                y0 + row as f64 * cell,
+                (end - start) as f64 * cell,
+                cell,
+                "black",
+            ));
         }
         doc.append(g);
     }

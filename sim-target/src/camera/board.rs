@@ -136,7 +136,7 @@ impl BoardCamera {
         }
         render::gaussian_blur(&mut canvas.data, cw, ch, im.blur_sigma_px);
         let irradiance = self.warp.apply(&canvas.data, cw, ch, im.floor_shade as f32);
-        let pixels = render::develop(
+        let pixels = super::sensor::develop(
             &irradiance,
             im.exposure,
             im.black_level,

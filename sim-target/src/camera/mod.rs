@@ -14,6 +14,7 @@ pub mod lens;
 pub mod live;
 pub mod render;
 pub mod scene_view;
+pub mod sensor;
 pub mod server;
 
 use std::path::{Path, PathBuf};
@@ -50,7 +51,7 @@ pub struct Imaging {
     pub ink: [f64; 2],
     /// White quiet zone around each tag beyond its own white border, in tag cells.
     pub quiet_cells: f64,
-    /// Supersampling per axis for markers, and sub-rows per pixel row for polygons.
+    /// Sub-rows per pixel row of polygons and markers (each with exact horizontal coverage).
     pub supersample: usize,
 }
 
@@ -294,7 +295,7 @@ impl Camera {
         };
         let cfg = &self.config;
         let im = &cfg.imaging;
-        let pixels = render::develop(
+        let pixels = sensor::develop(
             &still.irradiance,
             im.exposure,
             im.black_level,

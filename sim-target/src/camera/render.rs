@@ -1,13 +1,12 @@
 //! Anti-aliased rendering of the table seen from above: polygons (table, bodies) and AprilTag
-//! markers drawn by supersampling each pixel (pixel centres at `i + 0.5`), then the optics and
-//! the sensor: Gaussian blur, exposure, seeded noise, 8-bit quantisation.
+//! markers drawn with their exact area coverage of each pixel (scanlines: sub-rows with exact
+//! horizontal coverage), then the optics' Gaussian blur. The sensor (exposure, noise, 8-bit
+//! quantisation) is [`super::sensor`].
 //!
 //! Marker bit patterns come from the AprilTag library's family data ([`super::families`]), laid
 //! out exactly as its `apriltag_to_image` does.
 
 use super::families::{FamilyData, TAG25H9, TAG36H11};
-use rand::Rng;
-use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
 pub use pushbot_world::camera::{Homography, MarkerFamily, MarkerPlacement};
@@ -46,6 +45,27 @@ impl TagCodes {
     /// Whether a family has no ids (never, for the built-in ones).
     pub fn is_empty(&self, f: MarkerFamily) -> bool {
         self.len(f) == 0
+    }
+
+    /// The tag's black cells as runs along its rows: `(row, first column, end column)` (end
+    /// exclusive), row 0 at the top; drawn or printed as one rectangle each.
+    pub fn black_runs(pattern: &[bool], tw: usize) -> Vec<(usize, usize, usize)> {
+        let mut runs = Vec::new();
+        for (row, cells) in pattern.chunks_exact(tw.max(1)).enumerate().take(tw) {
+            let mut col = 0;
+            while col < cells.len() {
+                if cells[col] {
+                    col += 1;
+                    continue;
+                }
+                let start = col;
+                while col < cells.len() && !cells[col] {
+                    col += 1;
+                }
+                runs.push((row, start, col));
+            }
+        }
+        runs
     }
 
     /// The tag's image, `total_width`² cells row-major (row 0 at the top of the printed tag),
@@ -115,68 +135,7 @@ impl Canvas {
         Some(())
     }
 
-    /// Pixel bounding box (x0, y0, x1, y1 exclusive) of table points, clipped to the image.
-    fn bbox(&self, pts: &[[f64; 2]]) -> Option<(usize, usize, usize, usize)> {
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for p in pts {
-            let q = self.table_to_pixel.apply(*p)?;
-            for k in 0..2 {
-                lo[k] = lo[k].min(q[k]);
-                hi[k] = hi[k].max(q[k]);
-            }
-        }
-        let x0 = lo[0].floor().max(0.0) as usize;
-        let y0 = lo[1].floor().max(0.0) as usize;
-        let x1 = (hi[0].ceil() + 1.0).clamp(0.0, self.width as f64) as usize;
-        let y1 = (hi[1].ceil() + 1.0).clamp(0.0, self.height as f64) as usize;
-        (x0 < x1 && y0 < y1).then_some((x0, y0, x1, y1))
-    }
-
-    /// Cover the pixels in the box with `shade(p)` where it returns a value, averaging `n × n`
-    /// samples per pixel; samples where `shade` returns `None` keep the pixel's current value.
-    fn paint(
-        &mut self,
-        bbox: (usize, usize, usize, usize),
-        n: usize,
-        shade: impl Fn([f64; 2]) -> Option<f32>,
-    ) {
-        let (x0, y0, x1, y1) = bbox;
-        let inv = 1.0 / n as f64;
-        let h = self.pixel_to_table.0;
-        for y in y0..y1 {
-            for x in x0..x1 {
-                let old = self.data[y * self.width + x];
-                let mut sum = 0.0f32;
-                let mut hit = false;
-                for j in 0..n {
-                    let v = y as f64 + (j as f64 + 0.5) * inv;
-                    for i in 0..n {
-                        let u = x as f64 + (i as f64 + 0.5) * inv;
-                        let w = h[2][0] * u + h[2][1] * v + h[2][2];
-                        let p = [
-                            (h[0][0] * u + h[0][1] * v + h[0][2]) / w,
-                            (h[1][0] * u + h[1][1] * v + h[1][2]) / w,
-                        ];
-                        match shade(p) {
-                            Some(s) => {
-                                sum += s;
-                                hit = true;
-                            }
-                            None => sum += old,
-                        }
-                    }
-                }
-                if hit {
-                    self.data[y * self.width + x] = sum / (n * n) as f32;
-                }
-            }
-        }
-    }
-
-    /// Draw a filled polygon (even-odd rule). A homography maps lines to lines, so the polygon
-    /// is mapped to pixels and covered scanline by scanline: `n` sub-rows per pixel row, each
-    /// with exact horizontal coverage.
+    /// Draw a filled polygon (even-odd rule) of table points.
     pub fn polygon(&mut self, poly: &Polygon, n: usize) {
         if poly.points.len() < 3 {
             return;
@@ -189,11 +148,41 @@ impl Canvas {
         else {
             return;
         };
-        let Some((x0, y0, x1, y1)) = self.bbox(&poly.points) else {
+        self.fill(&[px], poly.shade as f32, n);
+    }
+
+    /// Fill the even-odd union of `rings` (pixel coordinates; rings that only share edges make
+    /// their union) with `shade`, blended by the covered fraction of each pixel. A homography
+    /// maps lines to lines, so what was a polygon on the table is one in pixels and is covered
+    /// scanline by scanline: `n` sub-rows per pixel row, each with exact horizontal coverage.
+    fn fill(&mut self, rings: &[Vec<[f64; 2]>], shade: f32, n: usize) {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for q in rings.iter().flatten() {
+            for k in 0..2 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        if !(lo.iter().chain(&hi).all(|v| v.is_finite())) {
             return;
-        };
+        }
+        let x0 = lo[0].floor().max(0.0) as usize;
+        let y0 = lo[1].floor().max(0.0) as usize;
+        let x1 = (hi[0].ceil() + 1.0).clamp(0.0, self.width as f64) as usize;
+        let y1 = (hi[1].ceil() + 1.0).clamp(0.0, self.height as f64) as usize;
+        if x0 >= x1 || y0 >= y1 {
+            return;
+        }
+        // Edges that a scanline can cross: (y of one end, y of the other, x at the first, dx/dy).
+        let edges: Vec<[f64; 4]> = rings
+            .iter()
+            .filter(|r| r.len() >= 3)
+            .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
+            .filter(|(a, b)| a[1] != b[1])
+            .map(|(a, b)| [a[1], b[1], a[0], (b[0] - a[0]) / (b[1] - a[1])])
+            .collect();
         let n = n.max(1);
-        let shade = poly.shade as f32;
         let mut cov = vec![0.0f64; x1 - x0];
         let mut xs: Vec<f64> = Vec::new();
         for y in y0..y1 {
@@ -201,10 +190,9 @@ impl Canvas {
             for j in 0..n {
                 let yy = y as f64 + (j as f64 + 0.5) / n as f64;
                 xs.clear();
-                for (i, &a) in px.iter().enumerate() {
-                    let b = px[(i + 1) % px.len()];
-                    if (a[1] > yy) != (b[1] > yy) {
-                        xs.push(a[0] + (yy - a[1]) * (b[0] - a[0]) / (b[1] - a[1]));
+                for &[ya, yb, xa, slope] in &edges {
+                    if (ya > yy) != (yb > yy) {
+                        xs.push(xa + (yy - ya) * slope);
                     }
                 }
                 xs.sort_by(|a, b| a.total_cmp(b));
@@ -236,7 +224,7 @@ impl Canvas {
     }
 
     /// Draw a marker with a white quiet zone `quiet_cells` wide around the tag image (beyond the
-    /// family's own one-cell white border), `n × n` supersampling; `black`/`white` reflectances.
+    /// family's own one-cell white border), `n` sub-rows per pixel row; `black`/`white` reflectances.
     #[allow(clippy::too_many_arguments)]
     pub fn marker(
         &mut self,
@@ -255,34 +243,47 @@ impl Canvas {
         }
         let cell = m.side / wab as f64;
         let half = (tw as f64 / 2.0 + quiet_cells) * cell;
-        let outer = MarkerPlacement {
-            side: 2.0 * half,
-            ..*m
+        if !(half > 0.0 && half.is_finite()) {
+            return Err(format!(
+                "marker {} has a quiet zone of {quiet_cells} cells",
+                m.id
+            ));
+        }
+        // Marker frame (a to the right, b up, metres from the centre) to pixels.
+        let (s, c) = m.heading.sin_cos();
+        let h = self.table_to_pixel;
+        let to_px =
+            |a: f64, b: f64| h.apply([m.centre[0] + c * a - s * b, m.centre[1] + s * a + c * b]);
+        let rect = |a0: f64, a1: f64, b0: f64, b1: f64| -> Option<Vec<[f64; 2]>> {
+            let (a0, a1) = (a0.max(-half), a1.min(half));
+            let (b0, b1) = (b0.max(-half), b1.min(half));
+            if a0 >= a1 || b0 >= b1 {
+                return Some(Vec::new());
+            }
+            Some(vec![
+                to_px(a0, b0)?,
+                to_px(a1, b0)?,
+                to_px(a1, b1)?,
+                to_px(a0, b1)?,
+            ])
         };
-        let Some(bbox) = self.bbox(&outer.corners()) else {
+        // The white square (tag image and quiet zone), then the black cells over it: each row's
+        // runs of black cells as rectangles, filled together so that shared edges leave no seam.
+        let Some(square) = rect(-half, half, -half, half) else {
             return Ok(());
         };
-        let (s, c) = m.heading.sin_cos();
-        let (b, w) = (black as f32, white as f32);
-        let twf = tw as f64;
-        self.paint(bbox, n, |p| {
-            let d = [p[0] - m.centre[0], p[1] - m.centre[1]];
-            let a = c * d[0] + s * d[1];
-            let bb = -s * d[0] + c * d[1];
-            if a.abs() >= half || bb.abs() >= half {
-                return None;
-            }
-            let col = a / cell + twf / 2.0;
-            let row = twf / 2.0 - bb / cell;
-            if col < 0.0 || row < 0.0 || col >= twf || row >= twf {
-                return Some(w);
-            }
-            Some(if pattern[row as usize * tw + col as usize] {
-                w
-            } else {
-                b
-            })
-        });
+        let t2 = tw as f64 / 2.0;
+        let mut black_rings = Vec::new();
+        for (row, start, end) in TagCodes::black_runs(&pattern, tw) {
+            let (a0, a1) = ((start as f64 - t2) * cell, (end as f64 - t2) * cell);
+            let (b0, b1) = ((t2 - row as f64 - 1.0) * cell, (t2 - row as f64) * cell);
+            let Some(r) = rect(a0, a1, b0, b1) else {
+                return Ok(());
+            };
+            black_rings.push(r);
+        }
+        self.fill(&[square], white as f32, n);
+        self.fill(&black_rings, black as f32, n);
         Ok(())
     }
 }
@@ -349,30 +350,6 @@ pub fn gaussian_blur(data: &mut [f32], width: usize, height: usize, sigma: f64) 
     }
 }
 
-/// The sensor: gray level = `black + (white − black) · exposure · reflectance + noise`, rounded
-/// and clamped to 8 bits; `noise_sigma` in gray levels.
-pub fn develop(
-    data: &[f32],
-    exposure: f64,
-    black: f64,
-    white: f64,
-    noise_sigma: f64,
-    rng: &mut impl Rng,
-) -> Vec<u8> {
-    let noise = Normal::new(0.0f32, noise_sigma.max(0.0) as f32).ok();
-    let gain = ((white - black) * exposure) as f32;
-    let black = black as f32;
-    data.iter()
-        .map(|&r| {
-            let n = match &noise {
-                Some(d) if noise_sigma > 0.0 => d.sample(rng),
-                _ => 0.0,
-            };
-            (black + gain * r + n).round().clamp(0.0, 255.0) as u8
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -434,6 +411,80 @@ mod tests {
         assert_eq!(c.data[2], 1.0);
         assert!((c.data[3] - 0.25).abs() < 1e-6, "{}", c.data[3]);
         assert_eq!(c.data[4], 0.0);
+    }
+
+    /// A marker turned and seen in perspective: each pixel is its exact coverage, as a
+    /// brute-force sampling of 48 × 48 points in every pixel finds it; no seam where black
+    /// cells of neighbouring rows meet.
+    #[test]
+    fn a_marker_is_drawn_with_its_coverage_of_each_pixel() {
+        let h = Homography([[600.0, 40.0, 10.0], [-30.0, 580.0, 15.0], [0.3, 0.2, 1.0]]);
+        let m = MarkerPlacement {
+            id: 7,
+            family: MarkerFamily::Tag36h11,
+            centre: [0.07, 0.07],
+            heading: 0.4,
+            side: 0.08,
+            height: 0.0,
+        };
+        let (black, white, quiet, old) = (0.04f32, 0.95f32, 1.0, 0.5f32);
+        let codes = TagCodes::new().unwrap();
+        let mut c = Canvas::new(110, 110, h, f64::from(old)).unwrap();
+        c.marker(&codes, &m, quiet, 64, f64::from(black), f64::from(white))
+            .unwrap();
+        let (pattern, tw, wab) = codes.pattern(m.family, m.id).unwrap();
+        let cell = m.side / wab as f64;
+        let half = (tw as f64 / 2.0 + quiet) * cell;
+        let inv = h.inverse().unwrap();
+        let (s, co) = m.heading.sin_cos();
+        let shade = |u: f64, v: f64| {
+            let p = inv.apply([u, v]).unwrap();
+            let d = [p[0] - m.centre[0], p[1] - m.centre[1]];
+            let (a, b) = (co * d[0] + s * d[1], -s * d[0] + co * d[1]);
+            if a.abs() >= half || b.abs() >= half {
+                return old;
+            }
+            let col = a / cell + tw as f64 / 2.0;
+            let row = tw as f64 / 2.0 - b / cell;
+            if col < 0.0 || row < 0.0 || col >= tw as f64 || row >= tw as f64 {
+                return white;
+            }
+            if pattern[row as usize * tw + col as usize] {
+                white
+            } else {
+                black
+            }
+        };
+        let (mut worst, mut sum, mut blacks) = (0.0f32, 0.0f32, 0);
+        let k = 48;
+        for y in 0..110 {
+            for x in 0..110 {
+                let mut r = 0.0f32;
+                for j in 0..k {
+                    for i in 0..k {
+                        let u = x as f64 + (i as f64 + 0.5) / k as f64;
+                        let v = y as f64 + (j as f64 + 0.5) / k as f64;
+                        r += shade(u, v);
+                    }
+                }
+                r /= (k * k) as f32;
+                let d = (c.data[y * 110 + x] - r).abs();
+                worst = worst.max(d);
+                sum += d;
+                blacks += usize::from((r - black).abs() < 1e-4);
+            }
+        }
+        assert!(
+            blacks > 300,
+            "the marker is in the image ({blacks} black pixels)"
+        );
+        assert!(
+            c.data[0] == old && c.data[110 * 110 - 1] == old,
+            "the marker is inside"
+        );
+        assert!(worst < 0.03, "worst pixel off by {worst}");
+        let mean = sum / (110.0 * 110.0);
+        assert!(mean < 1e-3, "mean error {mean}");
     }
 
     #[test]
