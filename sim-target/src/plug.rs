@@ -105,13 +105,14 @@ impl Port {
         if let Some(at) = self.replug_at {
             if now_us >= at {
                 let pty = Pty::open()?;
+                // Counted before the link shows the new pty (as an unplug is).
+                self.shared.replugs.fetch_add(1, Ordering::SeqCst);
                 if let Some(l) = &self.link {
                     point(l, pty.path())?;
                 }
                 tracing::info!("port plugged back in: {}", pty.path());
                 self.pty = Some(pty);
                 self.replug_at = None;
-                self.shared.replugs.fetch_add(1, Ordering::Relaxed);
             }
             return Ok(());
         }
@@ -128,13 +129,15 @@ impl Port {
                 // A request without a link: PtySim::unplug refuses it before it gets here.
                 return Ok(());
             }
+            // Counted before the host can see it: a host that gives up at once and asks how
+            // many unplugs there were must not find the one that ended its session missing.
+            self.shared.unplugs.fetch_add(1, Ordering::SeqCst);
             if let Some(l) = &self.link {
                 let _ = std::fs::remove_file(l);
             }
             tracing::info!("port unplugged for {} ms", for_us / 1000);
             self.pty = None;
             self.replug_at = Some(now_us.saturating_add(for_us));
-            self.shared.unplugs.fetch_add(1, Ordering::Relaxed);
         }
         Ok(())
     }

@@ -125,11 +125,12 @@ impl PtySim {
         Ok(())
     }
 
-    /// How many times the port was unplugged, and plugged back, so far.
+    /// How many times the port was unplugged, and plugged back, so far (each counted before a
+    /// host can notice it).
     pub fn unplugs(&self) -> (u32, u32) {
         (
-            self.plug.unplugs.load(Ordering::Relaxed),
-            self.plug.replugs.load(Ordering::Relaxed),
+            self.plug.unplugs.load(Ordering::SeqCst),
+            self.plug.replugs.load(Ordering::SeqCst),
         )
     }
 

@@ -37,6 +37,28 @@ fn connect(path: &std::path::Path, reconnect: Duration) -> Robot {
     robot
 }
 
+/// Once the robot has gone 2 cm from where it is now, unplug the port for `gap` of robot time.
+/// Waiting on the robot's own progress rather than on the wall clock keeps the unplug inside
+/// the move however loaded the machine is (a 0.3 m move has 2.8 s of robot time left then).
+fn unplug_once_moving(sim: &PtySim, gap: Duration) {
+    let from = sim.truth().pose;
+    pushbot_tests::wait_truth(sim, Duration::from_secs(60), |t| {
+        pushbot_tests::dist(&t.pose, &from) >= 0.02
+    })
+    .expect("the move starts");
+    sim.unplug(gap).expect("unplug");
+}
+
+/// Wait (up to 10 s of wall time) until the simulator has taken `n` unplugs: a request is
+/// served at its next step, which may come after the host has already given up.
+fn unplugs_reach(sim: &PtySim, n: u32) -> (u32, u32) {
+    let end = std::time::Instant::now() + Duration::from_secs(10);
+    while sim.unplugs().0 < n && std::time::Instant::now() < end {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    sim.unplugs()
+}
+
 /// Start a long move, unplug the port for `gap` of robot time, and return the move's end.
 fn unplug_during_a_move(sim: &PtySim, robot: &Robot, gap: Duration) -> (u16, LinkError) {
     let m = robot
@@ -46,8 +68,7 @@ fn unplug_during_a_move(sim: &PtySim, robot: &Robot, gap: Duration) -> (u16, Lin
             stop_on_contact: false,
         })
         .expect("move accepted");
-    std::thread::sleep(Duration::from_millis(100));
-    sim.unplug(gap).expect("unplug");
+    unplug_once_moving(sim, gap);
     let err = robot
         .wait(&m)
         .expect_err("the port went away under the move");
@@ -125,18 +146,11 @@ fn the_cli_move_waits_for_the_port_with_reconnect_and_fails_clearly_without() {
         ]);
         let cli = Cli::try_parse_from(&argv).expect("arguments parse");
         let result = std::thread::scope(|s| {
-            // 3 s of robot time into the move (0.6 s of wall time), the port goes for 2 s.
-            s.spawn(|| {
-                pushbot_tests::wait_truth(&sim, Duration::from_secs(30), |t| {
-                    t.duty.iter().any(|&u| u != 0.0)
-                })
-                .expect("the move starts");
-                std::thread::sleep(Duration::from_millis(200));
-                sim.unplug(Duration::from_secs(2)).expect("unplug");
-            });
+            // 2 cm into the move, the port goes for 2 s of robot time.
+            s.spawn(|| unplug_once_moving(&sim, Duration::from_secs(2)));
             run(cli)
         });
-        assert_eq!(sim.unplugs().0, 1, "unplugged once");
+        assert_eq!(unplugs_reach(&sim, 1).0, 1, "unplugged once");
         match reconnect {
             Some(_) => {
                 assert!(matches!(result, Ok(Status::Success)), "{result:?}");
