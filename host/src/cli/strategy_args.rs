@@ -35,6 +35,10 @@ pub struct SimArgs {
     /// Neighbours k of the regression.
     #[arg(long, default_value_t = 5)]
     pub k: usize,
+    /// How much the special case (re-positioning) prefers pushes that turn the object little:
+    /// metres of object motion a radian of turn weighs (0: the paper's motion alone).
+    #[arg(long, default_value_t = crate::strategy::regression::TURN_WEIGHT)]
+    pub turn_weight: f64,
     /// What the simulated robot sees the table with: `truth` (the simulator's poses with the
     /// noise above; fast) or `rendered` (frames rendered from the simulated world — lens,
     /// markers at their heights, blur, noise — read by the host's detector, calibration and
@@ -50,9 +54,13 @@ impl SimArgs {
                 "the kernel width must be positive and k at least 1",
             ));
         }
+        if !(self.turn_weight.is_finite() && self.turn_weight >= 0.0) {
+            return Err(CliError::bad_input("the turn weight must be a number ≥ 0"));
+        }
         Ok(KernelParams {
             k: self.k,
             kernel_width: self.kernel_width,
+            turn_weight: self.turn_weight,
         })
     }
 }
