@@ -408,3 +408,51 @@ fn a_boundary_reset_does_not_slide_an_off_centre_marker_along_the_edge() {
     }
     assert_eq!(inside, 8, "back inside from {inside} of 8 headings");
 }
+
+/// The collection explores with the paper's keys whatever the strategy's turn weight (the
+/// special case's preference for pushes that do not turn the object, Algorithm 2 beyond the
+/// paper), and gives the strategy its own parameters back: on the snake, whose pushes turn it
+/// most, a collection with test deliveries makes the same samples either way.
+#[test]
+fn the_collection_keeps_the_papers_keys_and_gives_the_strategy_its_own_back() {
+    let run = |turn_weight: f64| {
+        let scene = Scene::preset("lau-snake").unwrap();
+        let mut io = SimRobot::new(
+            scene,
+            None,
+            None,
+            SimRobotOptions {
+                seed: 5,
+                ..SimRobotOptions::default()
+            },
+        )
+        .unwrap();
+        let kernel = KernelParams {
+            turn_weight,
+            ..KernelParams::default()
+        };
+        let mut strat = PushStrategy::new(Vec::new(), kernel);
+        let params = CollectParams {
+            initial: 40,
+            streak: 3,
+            max_queries: 3,
+            seed: 5,
+            ..CollectParams::default()
+        };
+        let rep = collect(
+            &mut io,
+            &mut strat,
+            &params,
+            &mut |_| Ok(()),
+            &ProgressBar::hidden(),
+        )
+        .unwrap();
+        assert_eq!(strat.params(), kernel, "the strategy's own parameters");
+        (rep.queries, strat.samples().to_vec())
+    };
+    let (queries, paper) = run(0.0);
+    let (_, weighted) = run(0.1);
+    assert!(queries > 0, "the collection made test deliveries");
+    assert_eq!(paper.len(), weighted.len());
+    assert!(paper == weighted, "the samples differ");
+}
