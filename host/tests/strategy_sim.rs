@@ -23,15 +23,10 @@ fn initial_only(k: usize, seed: u64) -> CollectParams {
     }
 }
 
-fn collect_samples(
-    scene: &str,
-    k: usize,
-    seed: u64,
-    mut w: Option<&mut StrategyWriter>,
-) -> Vec<Sample> {
-    let scene = Scene::preset(scene).unwrap();
-    let mut io = SimRobot::new(
-        scene,
+/// The in-process simulated robot on the preset `scene`, seeded.
+fn sim_robot(scene: &str, seed: u64) -> SimRobot {
+    SimRobot::new(
+        Scene::preset(scene).unwrap(),
         None,
         None,
         SimRobotOptions {
@@ -39,7 +34,16 @@ fn collect_samples(
             ..SimRobotOptions::default()
         },
     )
-    .unwrap();
+    .unwrap()
+}
+
+fn collect_samples(
+    scene: &str,
+    k: usize,
+    seed: u64,
+    mut w: Option<&mut StrategyWriter>,
+) -> Vec<Sample> {
+    let mut io = sim_robot(scene, seed);
     let mut strat = PushStrategy::new(Vec::new(), KernelParams::default());
     let rep = collect(
         &mut io,
@@ -416,17 +420,7 @@ fn a_boundary_reset_does_not_slide_an_off_centre_marker_along_the_edge() {
 #[test]
 fn the_collection_keeps_the_papers_keys_and_gives_the_strategy_its_own_back() {
     let run = |turn_weight: f64| {
-        let scene = Scene::preset("lau-snake").unwrap();
-        let mut io = SimRobot::new(
-            scene,
-            None,
-            None,
-            SimRobotOptions {
-                seed: 5,
-                ..SimRobotOptions::default()
-            },
-        )
-        .unwrap();
+        let mut io = sim_robot("lau-snake", 5);
         let kernel = KernelParams {
             turn_weight,
             ..KernelParams::default()

@@ -488,7 +488,7 @@ pub fn collect(
     rep
 }
 
-/// [`collect`] with the strategy's parameters as they are.
+/// [`collect`] with the strategy's parameters as they are (it leaves the admission rule set).
 fn algorithm_1(
     io: &mut dyn RobotIo,
     strategy: &mut PushStrategy,
@@ -615,7 +615,6 @@ fn algorithm_1(
             break;
         }
     }
-    strategy.set_admission(None);
     // Leave the object inside the boundary, ready for a delivery.
     if outside(io) {
         rep.boundary_resets += bring_inside(io, margin, params.epsilon)?;

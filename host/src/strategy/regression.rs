@@ -307,8 +307,8 @@ impl PushStrategy {
         if q.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        let w = self.params.turn_weight;
-        let near = self.nearest(self.special.as_ref(), &|x| special_key(x, w), &q);
+        let tw = self.params.turn_weight;
+        let near = self.nearest(self.special.as_ref(), &|x| special_key(x, tw), &q);
         let w = self.weights(&near);
         let total: f64 = w.iter().sum();
         if near.is_empty() || total <= 0.0 {
