@@ -77,13 +77,19 @@ pub struct Workspace {
 /// the marker at `marker` (both in the object's frame), and the outline's smallest enclosing
 /// circle in the marker's frame. No outline: nothing to bound (a zero circle at the marker).
 pub fn object_bounds(outline: &[[f64; 2]], marker: [f64; 2]) -> (f64, Circle) {
-    let about: Vec<[f64; 2]> = outline
-        .iter()
-        .map(|v| [v[0] - marker[0], v[1] - marker[1]])
-        .collect();
+    let about = outline_about(outline, marker);
     let radius = about.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
     let body = enclosing_circle(&about).unwrap_or(Circle::at_origin(radius));
     (radius, body)
+}
+
+/// An outline (object frame) in the frame of its marker at `marker`: what the camera's pose of
+/// the marker places on the table.
+pub fn outline_about(outline: &[[f64; 2]], marker: [f64; 2]) -> Vec<[f64; 2]> {
+    outline
+        .iter()
+        .map(|v| [v[0] - marker[0], v[1] - marker[1]])
+        .collect()
 }
 
 impl Workspace {

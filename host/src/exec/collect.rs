@@ -33,7 +33,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::exec::deliver::{DeliveryParams, Failure, bound_all_radius, deliver_learned};
 use crate::exec::io::RobotIo;
-use crate::exec::maneuver::{Drive, Turn, circle_walk, face};
+use crate::exec::maneuver::{Around, Drive, Turn, circle_walk, face};
 use crate::strategy::active::{Selection, least_known, least_known_ahead};
 use crate::strategy::regression::{Admission, KernelParams, PushStrategy};
 use crate::strategy::sample::Sample;
@@ -202,7 +202,7 @@ pub fn reset_robot_obj_boundary(io: &mut dyn RobotIo, margin: f64, epsilon: f64)
             radius,
             push_angle,
             &Drive::two_level(0.05),
-            &[],
+            &Around::default(),
         )?;
         let o0 = io.object_pose().position();
         // (d) Push towards the object until it is back inside; give up this round when six
@@ -387,7 +387,7 @@ fn coverage_push(
         radius,
         stand_angle,
         &Drive::two_level(0.05),
-        &[],
+        &Around::default(),
     )?;
     // reset_robot's approach (face the marker, creep until the object moves), then a push
     // straight on, as the initial collection's pushes start from a touch.

@@ -18,7 +18,9 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use crate::exec::io::{Rect, RobotIo, Workspace};
-use crate::exec::maneuver::{Drive, Turn, WAY_POINT_ARRIVE, angle_of, circle_walk, face, go_to};
+use crate::exec::maneuver::{
+    Around, Drive, Turn, WAY_POINT_ARRIVE, angle_of, circle_walk, face, go_to, outline_on_table,
+};
 use crate::exec::reposition::{BoundAll, Stand, Standing, reachable_reposition};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
@@ -387,6 +389,9 @@ pub fn deliver_learned_among(
     // Among obstacles, the special case's stand points (object frame) whose push failed since
     // the last push that went the wanted way: not tried again while another is reachable.
     let mut failed: Vec<[f64; 2]> = Vec::new();
+    // The object's outline (its marker's frame; empty when not known): the special case
+    // stands the robot clear of it and walks round it.
+    let outline = io.object_outline();
     loop {
         let (r, o) = (io.robot_pose(), io.object_pose());
         traj.push((r, o));
@@ -463,6 +468,7 @@ pub fn deliver_learned_among(
             let robot = Standing {
                 from: r.position(),
                 failed: &failed,
+                outline: &outline,
             };
             let Some(Stand {
                 rep,
@@ -501,7 +507,10 @@ pub fn deliver_learned_among(
                 circle.radius,
                 angle_of(rel),
                 &Drive::one_leg(WAY_POINT_ARRIVE),
-                obstacles,
+                &Around {
+                    obstacles,
+                    object: &outline_on_table(&outline, &o),
+                },
             )?;
             go_to(io, at, &Drive::two_level(p.heading_tolerance))?;
             o.vector_to_world(Vector2::new(rep.r[0], rep.r[1]))
@@ -526,6 +535,13 @@ pub fn deliver_learned_among(
             &Turn::two_level(p.heading_tolerance),
         )?;
         let (r0, o0) = (io.robot_pose(), io.object_pose());
+        if stood.is_some() {
+            tracing::debug!(
+                "the re-positioning moved the object {:.4} m and turned it {:.3} rad",
+                (o0.position() - o.position()).norm(),
+                wrap_angle(o0.theta - o.theta)
+            );
+        }
         io.forward(step)?;
         steps += 1;
         let (r1, o1) = (io.robot_pose(), io.object_pose());

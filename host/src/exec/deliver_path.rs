@@ -18,6 +18,7 @@ use crate::exec::deliver::{
     Delivery, DeliveryParams, Failure, Recovery, bound_all_circle, deliver_learned_among,
 };
 use crate::exec::io::RobotIo;
+use crate::exec::maneuver::{Around, outline_on_table};
 use crate::exec::reposition::{BoundAll, approach_radius, recorded_pushes};
 use crate::planner::global::{ObstacleParams, clearance, plan_object_path};
 use crate::planner::path_follow::PathFollower;
@@ -218,6 +219,11 @@ fn side_step(
     let o = &o;
     let here = ws.body_centre(o);
     let keep = clearance(here, obstacles).min(ws.body.radius + op.object_margin);
+    let object = outline_on_table(&io.object_outline(), o);
+    let keep_clear = Around {
+        obstacles,
+        object: &object,
+    };
     (0..16)
         .map(|k| {
             let a = k as f64 * std::f64::consts::TAU / 16.0;
@@ -234,7 +240,7 @@ fn side_step(
                     .chain(
                         recorded_pushes(strategy, [local.x, local.y], SIDE_STEP_OFF).map(|c| c.1),
                     )
-                    .any(|rep| approach_radius(ws, obstacles, o, from, &rep, bound_all).is_some())
+                    .any(|rep| approach_radius(ws, &keep_clear, o, from, &rep, bound_all).is_some())
         })
         .max_by(|a, b| a.dot(&want).total_cmp(&b.dot(&want)))
         .map(|d| o.position() + d * SIDE_STEP)

@@ -30,6 +30,12 @@ pub trait RobotIo {
     fn time(&self) -> f64;
     /// The workspace.
     fn workspace(&self) -> Workspace;
+    /// The outline of the object being delivered, in its marker's frame, as the scene gives
+    /// it; empty when it is not known (the special case then stands the robot where the
+    /// regression says, as the paper does).
+    fn object_outline(&self) -> Vec<[f64; 2]> {
+        Vec::new()
+    }
     /// The path the robot is working along (table metres), for views and recordings; a robot
     /// that shows nothing ignores it.
     fn show_path(&mut self, _path: &[[f64; 2]]) {}

@@ -29,7 +29,7 @@ use crate::vision::calibration::Calibration;
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
 use crate::vision::tracking::TrackerParams;
-use pushbot_world::workspace::object_bounds;
+use pushbot_world::workspace::{object_bounds, outline_about};
 
 /// Settings of a [`LiveRobot`].
 #[derive(Debug, Clone, PartialEq)]
@@ -115,6 +115,8 @@ pub struct LiveRobot {
     /// The object [`RobotIo::object_pose`] reports, if the scene has one.
     object: Option<String>,
     marker: [f64; 2],
+    /// The object's outline in its marker's frame.
+    outline: Vec<[f64; 2]>,
     workspace: Workspace,
     /// Latest pose of each body (`robot`, object ids, `goal:<id>`) and the frame time it is for.
     poses: HashMap<String, (Pose2, f64)>,
@@ -176,7 +178,9 @@ impl LiveRobot {
         let marker = object
             .and_then(|o| o.marker)
             .map_or([0.0, 0.0], |m| [m.x, m.y]);
-        let (object_radius, body) = object_bounds(object.map_or(&[][..], |o| &o.outline), marker);
+        let outline = object.map_or(&[][..], |o| &o.outline);
+        let (object_radius, body) = object_bounds(outline, marker);
+        let outline = outline_about(outline, marker);
         let table = Rect {
             min: [0.0, 0.0],
             max: [scene.table.width, scene.table.height],
@@ -244,6 +248,7 @@ impl LiveRobot {
             pipeline,
             object: object.map(|o| o.id.clone()),
             marker,
+            outline,
             workspace,
             poses: HashMap::new(),
             fresh: false,
@@ -548,6 +553,10 @@ impl RobotIo for LiveRobot {
 
     fn workspace(&self) -> Workspace {
         self.workspace
+    }
+
+    fn object_outline(&self) -> Vec<[f64; 2]> {
+        self.outline.clone()
     }
 
     fn show_path(&mut self, path: &[[f64; 2]]) {

@@ -10,7 +10,7 @@ use anyhow::Result;
 use nalgebra::Vector2;
 
 use crate::exec::io::{RobotIo, Workspace};
-use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
+use crate::planner::global::{clearance, plan_robot_path, robot_fits, segment_clear};
 use crate::strategy::sample::{Pose2, wrap_angle};
 
 /// How to turn to a heading: up to `tries` spins, each from a fresh measurement, stopping once
@@ -195,7 +195,10 @@ pub fn transit(
 /// measurement), with one leg each ([`Drive::one_leg`], within [`WAY_POINT_ARRIVE`]).
 /// Where a wall made the end come in closer than the bound-all circle (`radius` < `outer`),
 /// the points on the way stay as far out as `outer` where the robot fits there: a walk at the
-/// closer radius would sweep through the object.
+/// closer radius would sweep through the object. A robot inside the circle backs straight
+/// out onto it; where a wall is in that way (it pushed the object along the wall, or from an
+/// L's inner corner facing one) it backs along its last push instead and drives a path round
+/// the obstacles and the object ([`around_object`], `keep_clear`) to the end.
 pub fn circle_walk(
     io: &mut dyn RobotIo,
     centre: Vector2<f64>,
@@ -203,8 +206,9 @@ pub fn circle_walk(
     outer: f64,
     to: f64,
     end: &Drive,
-    obstacles: &[Vec<[f64; 2]>],
+    keep_clear: &Around,
 ) -> Result<()> {
+    let obstacles = keep_clear.obstacles;
     let ws = io.workspace();
     let reach = ws.reachable();
     let clamp = |p: Vector2<f64>| {
@@ -230,7 +234,6 @@ pub fn circle_walk(
     } else {
         r.theta + std::f64::consts::PI
     };
-    let around = around_object(&ws, obstacles, centre, radius);
     let inside = rel.norm() < radius;
     // An obstacle cuts the circle both ways (a corridor, a wall's end) or stands where the
     // robot would join it: the stand point is reached by a path around the obstacles and the
@@ -238,12 +241,41 @@ pub fn circle_walk(
     let cut = !obstacles.is_empty() && circle_cut(&ws, obstacles, &on, from, to, inside);
     let way = Drive::one_leg(WAY_POINT_ARRIVE);
     if inside {
-        // Back straight away from the centre onto the circle.
-        face(io, angle_of(-rel), &end.turn)?;
-        let back = clamp(wide(from)) - io.robot_pose().position();
-        io.forward(-back.norm())?;
+        let out = clamp(wide(from));
+        // The way straight out, past the first centimetre (a robot that pushed the object
+        // along a wall touches the wall).
+        let way_out = (out - r.position()).norm();
+        let n = (way_out / 0.005).ceil() as usize;
+        let free = obstacles.is_empty()
+            || (2..=n).all(|k| {
+                let t = r.position() + (out - r.position()) * (k as f64 / n as f64);
+                robot_fits(&ws, obstacles, t)
+            });
+        if free {
+            // Back straight away from the centre onto the circle.
+            face(io, angle_of(-rel), &end.turn)?;
+            let back = out - io.robot_pose().position();
+            io.forward(-back.norm())?;
+        } else {
+            // A wall is in the way out: back along the push just made, the way the robot came
+            // (the object went ahead of it, nothing else was there), to leave the object's
+            // touch before a path round it is driven.
+            let behind = r.position() - RETREAT * Vector2::new(r.theta.cos(), r.theta.sin());
+            if reach.contains(behind) {
+                io.forward(-RETREAT)?;
+            }
+        }
     }
-    if cut {
+    let here = if inside {
+        io.robot_pose().position()
+    } else {
+        r.position()
+    };
+    let around = around_object(&ws, keep_clear, centre, radius, here);
+    // A robot a wall kept from backing out onto the circle (it pushed the object along the
+    // wall) cannot walk the circle's chords from there: they pass through the object.
+    let stuck = inside && (here - centre).norm() < radius - WAY_POINT_ARRIVE;
+    if cut || stuck {
         return transit(io, on(to), &around, end);
     }
     if !inside {
@@ -268,33 +300,71 @@ pub fn circle_walk(
     Ok(())
 }
 
+/// How far a robot inside the circle with a wall in its way out backs along its last push
+/// before a path round the object is planned, m.
+const RETREAT: f64 = 0.025;
+
 /// How near a walk's way points the robot must come, m.
 pub const WAY_POINT_ARRIVE: f64 = 0.01;
 
-/// `obstacles` and, when there are any, the object inside the bound-all circle of `radius`
-/// about `centre` as one more (a 12-gon the robot on the circle clears): what a path to a
-/// stand point on the circle must go round.
+/// What a walk round the object keeps clear of.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Around<'a> {
+    /// The obstacles, table-frame polygons.
+    pub obstacles: &'a [Vec<[f64; 2]>],
+    /// The object's outline in the table frame ([`outline_on_table`]); empty when not known.
+    pub object: &'a [[f64; 2]],
+}
+
+/// `outline` (the object's frame, [`RobotIo::object_outline`]) placed on the table by the
+/// object's pose `o`.
+pub fn outline_on_table(outline: &[[f64; 2]], o: &Pose2) -> Vec<[f64; 2]> {
+    outline
+        .iter()
+        .map(|v| {
+            let w = o.point_to_world(Vector2::new(v[0], v[1]));
+            [w.x, w.y]
+        })
+        .collect()
+}
+
+/// The obstacles of `keep_clear` and, when there are any, the object inside the bound-all
+/// circle of `radius` about `centre` as one more: what a path from the robot at `from` to a
+/// stand point on the circle must go round. The object is a 12-gon the robot on the circle
+/// clears, or — when the robot at `from` is too close to that 12-gon to plan from (it pushed
+/// from inside the circle, in an L's inner corner) and the outline is known — the outline
+/// itself, so that the way out of the corner goes round the object's arms rather than
+/// through them.
 pub fn around_object(
     ws: &Workspace,
-    obstacles: &[Vec<[f64; 2]>],
+    keep_clear: &Around,
     centre: Vector2<f64>,
     radius: f64,
+    from: Vector2<f64>,
 ) -> Vec<Vec<[f64; 2]>> {
-    let mut around = obstacles.to_vec();
+    let mut around = keep_clear.obstacles.to_vec();
     let inner = radius - ws.robot_radius - 0.015;
-    if inner > 0.0 && !obstacles.is_empty() {
-        around.push(
-            (0..12)
-                .map(|k| {
-                    let a = k as f64 * std::f64::consts::TAU / 12.0;
-                    let p = centre + inner * Vector2::new(a.cos(), a.sin());
-                    [p.x, p.y]
-                })
-                .collect(),
-        );
+    if inner > 0.0 && !keep_clear.obstacles.is_empty() {
+        let gon: Vec<[f64; 2]> = (0..12)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 12.0;
+                let p = centre + inner * Vector2::new(a.cos(), a.sin());
+                [p.x, p.y]
+            })
+            .collect();
+        let trapped = clearance(from, std::slice::from_ref(&gon)) < ws.robot_radius + TRAPPED;
+        around.push(if trapped && keep_clear.object.len() >= 3 {
+            keep_clear.object.to_vec()
+        } else {
+            gon
+        });
     }
     around
 }
+
+/// The robot is too close to the object's 12-gon to plan a path from where it is when its
+/// bumper is nearer to it than this, m (the robot path planner's margin and half a cell).
+const TRAPPED: f64 = 0.025;
 
 /// The two ways along the circle from angle `from` to `to`, as the angles of chords of at most
 /// 30°, the short way first.
@@ -436,7 +506,16 @@ mod tests {
             track: Vec::new(),
         };
         let end = Drive::two_level(0.05);
-        circle_walk(&mut io, C, radius, outer, std::f64::consts::PI, &end, &[]).unwrap();
+        circle_walk(
+            &mut io,
+            C,
+            radius,
+            outer,
+            std::f64::consts::PI,
+            &end,
+            &Around::default(),
+        )
+        .unwrap();
         let target = C - Vector2::new(radius, 0.0);
         let miss = (io.pose.position() - target).norm();
         assert!(miss <= end.arrive, "ended {miss:.4} m from the walk's end");
@@ -468,5 +547,61 @@ mod tests {
             assert!(d > 0.14, "a way point {d:.3} m from the object");
         }
         assert!(last.iter().all(|p| (p - C).norm() < 0.12), "{last:?}");
+    }
+
+    /// A walk from the inner corner of an L (12 × 14 cm, 4 cm arms, its corner's opening
+    /// facing a wall 10 cm away), where the robot has just pushed one arm, to a stand point
+    /// on the far side; driven by [`Short`]. Returns the closest the robot's centre came to the
+    /// L's outline after its first 5 mm; the walk knows the outline when `known`.
+    fn walk_out_of_an_l(known: bool) -> f64 {
+        let l = [
+            [-0.02, -0.025],
+            [0.10, -0.025],
+            [0.10, 0.015],
+            [0.02, 0.015],
+            [0.02, 0.115],
+            [-0.02, 0.115],
+        ];
+        let o = Pose2::new(1.296, 0.684, 2.26);
+        let outline = outline_on_table(&l, &o);
+        let wall = vec![rect(1.0, 0.4, 1.1, 1.2)];
+        let start = Pose2::new(1.201, 0.684, -1.76);
+        let mut io = Short {
+            pose: start,
+            drives: 0,
+            track: Vec::new(),
+        };
+        let centre = Vector2::new(1.236, 0.687);
+        let keep_clear = Around {
+            obstacles: &wall,
+            object: if known { &outline } else { &[] },
+        };
+        let end = Drive::two_level(0.05);
+        circle_walk(&mut io, centre, 0.152, 0.152, 0.51, &end, &keep_clear).unwrap();
+        let mut closest = f64::INFINITY;
+        let mut at = start.position();
+        for next in io.track {
+            let n = ((next - at).norm() / 0.002).ceil().max(1.0) as usize;
+            for k in 0..=n {
+                let p = at + (next - at) * (k as f64 / n as f64);
+                if (p - start.position()).norm() > 0.005 {
+                    closest = closest.min(crate::planner::global::polygon_distance(p, &outline));
+                }
+            }
+            at = next;
+        }
+        closest
+    }
+
+    /// Out of an L's inner corner with a wall in the way straight out: the robot backs along
+    /// the push it made and drives round the outline itself, never closer to it than its
+    /// 4 cm radius. Round the bound-all circle's 12-gon instead (the outline not known) it
+    /// has no path from inside the 12-gon and its way out runs more than 5 mm into an arm.
+    #[test]
+    fn a_walk_out_of_an_inner_corner_goes_round_the_outline() {
+        let clear = walk_out_of_an_l(true);
+        assert!(clear >= 0.04 - 1e-3, "came {clear:.4} m from the outline");
+        let blind = walk_out_of_an_l(false);
+        assert!(blind < 0.035, "without the outline: {blind:.4} m");
     }
 }

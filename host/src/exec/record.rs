@@ -165,6 +165,10 @@ impl RobotIo for Recorder<'_> {
         self.inner.workspace()
     }
 
+    fn object_outline(&self) -> Vec<[f64; 2]> {
+        self.inner.object_outline()
+    }
+
     fn show_path(&mut self, path: &[[f64; 2]]) {
         if let Some(h) = &self.recording {
             h.with(|r| r.planned_path(path));

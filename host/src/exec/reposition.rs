@@ -3,13 +3,15 @@
 //! wanted direction, moved only as far as walls make it. The approach comes in closer than the
 //! bound-all circle (Fig. 3) where a wall cuts that circle, and only when no approach works is
 //! the wanted direction turned or a single recorded push (a sample, §III-B) stood in for the
-//! regression. [`crate::exec::deliver::deliver_learned_among`] walks the robot there.
+//! regression. [`crate::exec::deliver::deliver_learned_among`] walks the robot there. On any
+//! table, a stand point the regression averaged into the object itself (pushes from both
+//! flanks of a thin or concave object) is moved back out along its push ([`stand_clear`]).
 
 use nalgebra::Vector2;
 
 use crate::exec::io::Workspace;
-use crate::exec::maneuver::around_object;
-use crate::planner::global::{plan_robot_path, robot_fits, segment_clear};
+use crate::exec::maneuver::{Around, around_object, outline_on_table};
+use crate::planner::global::{plan_robot_path, polygon_distance, robot_fits, segment_clear};
 use crate::strategy::regression::{PushStrategy, Reposition};
 use crate::strategy::sample::{Pose2, wrap_angle};
 use std::f64::consts::FRAC_PI_2;
@@ -32,6 +34,9 @@ pub(crate) struct Standing<'a> {
     pub from: Vector2<f64>,
     /// Stand points that failed, object frame.
     pub failed: &'a [[f64; 2]],
+    /// The object's outline in its marker's frame ([`crate::exec::io::RobotIo::object_outline`];
+    /// empty when not known): a stand point inside it is moved out ([`stand_clear`]).
+    pub outline: &'a [[f64; 2]],
 }
 
 /// A candidate stand point closer than this to one that failed counts as that one, m.
@@ -64,7 +69,8 @@ pub(crate) fn reachable_reposition(
     want: [f64; 2],
     bound_all: &BoundAll,
 ) -> Option<Stand> {
-    let first = strategy.special(want)?;
+    let clear = |rep| stand_clear(rep, robot.outline, ws.robot_radius);
+    let first = clear(strategy.special(want)?);
     let stand = |rep, radius| Stand {
         rep,
         radius,
@@ -73,8 +79,13 @@ pub(crate) fn reachable_reposition(
     if obstacles.is_empty() {
         return Some(stand(first, bound_all.radius));
     }
+    let object = outline_on_table(robot.outline, o);
+    let keep_clear = Around {
+        obstacles,
+        object: &object,
+    };
     let approach_radius =
-        |rep: &Reposition| approach_radius(ws, obstacles, o, robot.from, rep, bound_all);
+        |rep: &Reposition| approach_radius(ws, &keep_clear, o, robot.from, rep, bound_all);
     let fresh = |rep: &Reposition| {
         robot
             .failed
@@ -94,7 +105,7 @@ pub(crate) fn reachable_reposition(
     let turned = SPECIAL_TURNS_DEG[1..].iter().filter_map(|deg| {
         let (s, c) = deg.to_radians().sin_cos();
         let rep = strategy.special([c * want[0] - s * want[1], s * want[0] + c * want[1]])?;
-        Some((deg.abs().to_radians(), rep))
+        Some((deg.abs().to_radians(), clear(rep)))
     });
     let mut candidates: Vec<(f64, Reposition)> = turned
         .chain(recorded_pushes(strategy, want, FRAC_PI_2))
@@ -111,6 +122,42 @@ pub(crate) fn reachable_reposition(
                 radius: bound_all.radius,
                 reachable: false,
             })
+        })
+}
+
+/// A stand point counts as clear of the outline when the robot's bumper overlaps it by no
+/// more than this, m: the recorded stand points are in contact, give or take the camera.
+const STAND_OVERLAP: f64 = 0.003;
+
+/// How far outside the outline a stand point that was inside it is moved, m.
+const STAND_GAP: f64 = 0.004;
+
+/// Furthest a stand point is moved back out of the outline, m.
+const STAND_BACK_MAX: f64 = 0.25;
+
+/// `rep` with its stand point clear of the object: the regression (Algorithm 2) averages the
+/// stand points of pushes that moved the object alike, and when they came from different sides
+/// of a concave or thin object (an L's two arms, a snake's two flanks) the average can lie
+/// inside the object, where driving to it would knock the object away before the push. Such a
+/// stand point is moved back against the push, along −r, to where the robot's bumper (of
+/// `robot_radius`) first clears `outline` (object frame) by [`STAND_GAP`]: where a robot
+/// pushing along r from further back would touch the object. Unchanged when it is clear, when
+/// the outline is not known, or when no point within [`STAND_BACK_MAX`] clears it.
+pub(crate) fn stand_clear(rep: Reposition, outline: &[[f64; 2]], robot_radius: f64) -> Reposition {
+    let p = Vector2::new(rep.p[0], rep.p[1]);
+    if outline.len() < 3 || polygon_distance(p, outline) >= robot_radius - STAND_OVERLAP {
+        return rep;
+    }
+    let Some(back) = Vector2::new(-rep.r[0], -rep.r[1]).try_normalize(1e-9) else {
+        return rep;
+    };
+    let steps = (STAND_BACK_MAX / 0.002) as usize;
+    (1..=steps)
+        .map(|k| p + back * (0.002 * k as f64))
+        .find(|q| polygon_distance(*q, outline) >= robot_radius + STAND_GAP)
+        .map_or(rep, |q| Reposition {
+            p: [q.x, q.y],
+            ..rep
         })
 }
 
@@ -146,16 +193,17 @@ pub(crate) fn recorded_pushes(
 /// `from`, comes in to push as `rep` says: the bound-all circle where its point is clear, else
 /// closer in 1 cm steps down to [`APPROACH_GAP`] outside the stand point; `None` when the
 /// stand point does not fit or no approach point on that line does with a path to it round
-/// `obstacles` and the object.
+/// the obstacles and the object ([`around_object`]).
 pub(crate) fn approach_radius(
     ws: &Workspace,
-    obstacles: &[Vec<[f64; 2]>],
+    keep_clear: &Around,
     o: &Pose2,
     from: Vector2<f64>,
     rep: &Reposition,
     circle: &BoundAll,
 ) -> Option<f64> {
     let (centre, bound_all) = (circle.centre, circle.radius);
+    let obstacles = keep_clear.obstacles;
     let at = o.point_to_world(Vector2::new(rep.p[0], rep.p[1]));
     let rel = at - centre;
     if !robot_fits(ws, obstacles, at) {
@@ -170,7 +218,7 @@ pub(crate) fn approach_radius(
         .map(|k| (bound_all - 0.01 * k as f64).max(closest))
         .find(|&radius| {
             let approach = centre + radius * u;
-            let around = around_object(ws, obstacles, centre, radius);
+            let around = around_object(ws, keep_clear, centre, radius, from);
             robot_fits(ws, obstacles, approach)
                 && (segment_clear(ws, &around, from, approach)
                     || plan_robot_path(ws, &around, from, approach).is_some())
@@ -229,6 +277,70 @@ mod tests {
         )
     }
 
+    /// A bar 14 cm long and 2.4 cm thin (a snake's width), pushed along its length from either
+    /// flank alike: the regression averages the two stand points to one inside the bar. With
+    /// the outline known the robot stands at the bar's end instead, back along the push, its
+    /// bumper clear of the bar; without it, the average is kept as the paper has it.
+    #[test]
+    fn a_stand_point_averaged_into_the_object_is_moved_back_out_along_the_push() {
+        let bar = [
+            [-0.07, -0.012],
+            [0.07, -0.012],
+            [0.07, 0.012],
+            [-0.07, 0.012],
+        ];
+        let samples = [1.0, -1.0].into_iter().flat_map(|side| {
+            [0.025, 0.03, 0.035].map(|push| Sample {
+                p: [-0.02, side * 0.052],
+                r: [push, -side * 0.01],
+                s: [0.6 * push, 0.0],
+                theta: 0.0,
+            })
+        });
+        let strategy = PushStrategy::new(
+            samples,
+            crate::strategy::regression::KernelParams::default(),
+        );
+        let ws = lau_table(0.075);
+        let o = Pose2::new(0.8, 0.6, 0.3);
+        let circle = BoundAll {
+            centre: o.position(),
+            radius: bound_all_radius(&ws, 0.02),
+        };
+        let from = Vector2::new(0.5, 0.3);
+        let stand = |outline: &[[f64; 2]]| {
+            let robot = Standing {
+                from,
+                failed: &[],
+                outline,
+            };
+            reachable_reposition(&strategy, &ws, &[], &o, robot, [1.0, 0.0], &circle)
+                .expect("a re-positioning")
+                .rep
+        };
+        let inside = stand(&[]);
+        let p = Vector2::new(inside.p[0], inside.p[1]);
+        assert!(polygon_distance(p, &bar) < 0.005, "the average: {inside:?}");
+        let out = stand(&bar);
+        let q = Vector2::new(out.p[0], out.p[1]);
+        let clear = polygon_distance(q, &bar);
+        assert!(
+            (ws.robot_radius + STAND_GAP..ws.robot_radius + STAND_GAP + 0.003).contains(&clear),
+            "{clear} from the bar: {out:?}"
+        );
+        // Moved straight back against the push, which is kept.
+        let back = (q - p).normalize();
+        let push = Vector2::new(out.r[0], out.r[1]).normalize();
+        assert!(back.dot(&push) < -0.999, "{inside:?} -> {out:?}");
+        assert_eq!(out.r, inside.r);
+        // A stand point already clear is left where it is.
+        let aside = Reposition {
+            p: [0.0, 0.06],
+            r: [0.0, -0.03],
+        };
+        assert_eq!(stand_clear(aside, &bar, ws.robot_radius), aside);
+    }
+
     /// An object at the bottom of a 0.3 m corridor (walls at x 0.6–0.7 and 1.0–1.1), to be
     /// pushed right. Its stand point, 8 cm to its left, fits; the bound-all circle's point
     /// there is inside the left wall. The robot comes in closer, from within the corridor,
@@ -248,7 +360,11 @@ mod tests {
             radius: bound_all,
         };
         let from = Vector2::new(0.85, 0.6);
-        let at = |from| Standing { from, failed: &[] };
+        let at = |from| Standing {
+            from,
+            failed: &[],
+            outline: &[],
+        };
         let Stand { rep, radius, .. } =
             reachable_reposition(&strategy, &ws, &walls, &o, at(from), [1.0, 0.0], &circle)
                 .expect("a re-positioning");
@@ -334,7 +450,11 @@ mod tests {
             let rep = strategy.special([c, s]).expect("an answer");
             assert!(stands_in_a_wall(&rep), "turned {deg}°: {rep:?}");
         }
-        let robot = Standing { from, failed: &[] };
+        let robot = Standing {
+            from,
+            failed: &[],
+            outline: &[],
+        };
         let stand = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
             .expect("a re-positioning");
         assert_eq!(stand.rep.p, below, "{stand:?}");
@@ -344,6 +464,7 @@ mod tests {
         let robot = Standing {
             from,
             failed: &[below],
+            outline: &[],
         };
         let stand = reachable_reposition(&strategy, &ws, &walls, &o, robot, [1.0, 0.0], &circle)
             .expect("a re-positioning");

@@ -20,7 +20,7 @@ use crate::exec::occlusion::{self, BodyLost, Looking};
 use crate::link::{LinkError, Refusal};
 use crate::robot::{LinkOptions, Robot};
 use crate::strategy::sample::{Pose2, wrap_angle};
-use pushbot_world::workspace::object_bounds;
+use pushbot_world::workspace::{object_bounds, outline_about};
 
 /// Settings of the in-process robot.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,6 +88,8 @@ pub struct SimRobot {
     /// The object's id (what the camera calls it).
     object_id: String,
     marker: [f64; 2],
+    /// The object's outline in its marker's frame.
+    outline: Vec<[f64; 2]>,
     workspace: Workspace,
     margin: f64,
     /// The rendered camera, with [`SimCamera::Rendered`].
@@ -159,6 +161,7 @@ impl SimRobot {
         let robot_marker = [scene.camera.robot_marker.x, scene.camera.robot_marker.y];
         let marker = obj.marker.map_or([0.0, 0.0], |m| [m.x, m.y]);
         let (object_radius, body) = object_bounds(&obj.outline, marker);
+        let outline = outline_about(&obj.outline, marker);
         let scene_table = Rect {
             min: [0.0, 0.0],
             max: [scene.table.width, scene.table.height],
@@ -220,6 +223,7 @@ impl SimRobot {
             object,
             object_id,
             marker,
+            outline,
             workspace,
             margin: m,
             camera,
@@ -557,6 +561,10 @@ impl RobotIo for SimRobot {
 
     fn workspace(&self) -> Workspace {
         self.workspace
+    }
+
+    fn object_outline(&self) -> Vec<[f64; 2]> {
+        self.outline.clone()
     }
 }
 
