@@ -17,80 +17,18 @@
 use anyhow::Result;
 use nalgebra::Vector2;
 
+pub use crate::exec::delivery_params::DeliveryParams;
+use crate::exec::drift::{Push, reposition_next};
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::exec::maneuver::{
     Around, Drive, Turn, WAY_POINT_ARRIVE, angle_of, circle_walk, face, go_to, outline_on_table,
 };
 use crate::exec::reposition::{BoundAll, Stand, Standing, reachable_reposition};
+use crate::exec::stall::StallWatch;
 use crate::planner::path_follow::PathFollower;
-use crate::strategy::dipole::{self, DipoleCommand, DipoleParams};
+use crate::strategy::dipole::{self, DipoleCommand};
 use crate::strategy::regression::PushStrategy;
 use crate::strategy::sample::{Pose2, Sample, wrap_angle};
-
-/// Parameters of delivery.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DeliveryParams {
-    /// Success: the object's marker within this distance of the goal, m (the paper: 2.2 cm).
-    pub success_radius: f64,
-    /// Failure when not delivered within this time, s (the paper: 8 minutes).
-    pub time_limit: f64,
-    /// Coarse push length, m.
-    pub coarse_step: f64,
-    /// Fine push length, m.
-    pub fine_step: f64,
-    /// Object–goal distance below which pushes are fine, m.
-    pub fine_radius: f64,
-    /// Heading error left after a coarse spin that a fine spin corrects, rad.
-    pub heading_tolerance: f64,
-    /// The object moved if its marker moved at least this far, m.
-    pub moved_epsilon: f64,
-    /// Extra space of the bound-all circle beyond the robot's and the object's radii, m.
-    pub bound_all_margin: f64,
-    /// Width of the band inside the boundary where the wanted object motion is pulled inward,
-    /// m (0: off, as in the paper).
-    pub boundary_guard: f64,
-    /// Strength of that pull at the boundary, relative to the unit goal direction.
-    pub boundary_pull: f64,
-    /// The special case (re-positioning) follows a push whose object motion missed the wanted
-    /// motion by more than this, rad. The paper's is a quarter turn (the object moved away
-    /// from the goal). Among obstacles it is tighter
-    /// ([`crate::planner::global::ObstacleParams::reposition_angle`]): a push that drifts is
-    /// not continued, so the object keeps to its path.
-    pub reposition_angle: f64,
-    /// Stall: the object came no closer to the goal by [`Self::stall_progress`] (or half the
-    /// way still left to the success radius, if less) for this long, s; 0 turns it off (as in
-    /// the paper, and for deliveries on a clear table). Deliveries among obstacles set it
-    /// ([`crate::planner::global::ObstacleParams::stall_time`]) and recover.
-    pub stall_time: f64,
-    /// Progress towards the goal that counts against a stall, m.
-    pub stall_progress: f64,
-    /// Dipole baseline: length of one drive step, s.
-    pub dipole_step: f64,
-    /// Dipole baseline: controller parameters.
-    pub dipole: DipoleParams,
-}
-
-impl Default for DeliveryParams {
-    fn default() -> Self {
-        DeliveryParams {
-            success_radius: 0.022,
-            time_limit: 480.0,
-            coarse_step: 0.04,
-            fine_step: 0.015,
-            fine_radius: 0.1,
-            heading_tolerance: 0.05,
-            moved_epsilon: 0.003,
-            bound_all_margin: 0.02,
-            boundary_guard: 0.06,
-            boundary_pull: 1.0,
-            reposition_angle: std::f64::consts::FRAC_PI_2,
-            stall_time: 0.0,
-            stall_progress: 0.02,
-            dipole_step: 0.25,
-            dipole: DipoleParams::default(),
-        }
-    }
-}
 
 /// Why a delivery failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -383,7 +321,11 @@ pub fn deliver_learned_among(
     let mut last_leg = false;
     // Along a path the wanted motion is the enclosing circle's centre's, so the strategy is
     // asked for the pushes that moved that point so: the samples keyed on it
-    // ([`PushStrategy::about`]). The marker's own keys serve the last leg and a clear table.
+    // ([`PushStrategy::about`]). In the last leg too, where the marker is wanted at the goal:
+    // the pushes that moved the marker that way include those that did it by turning the
+    // object about it (the L-shape's marker is in its corner), which swing the body about
+    // near the goal; the body's keys ask for carrying it there. The marker's own keys serve
+    // a clear table.
     let body = ws.body.centre;
     let mut about_body = (path.is_some() && body != [0.0, 0.0]).then(|| strategy.about(body));
     // Among obstacles, the special case's stand points (object frame) whose push failed since
@@ -458,10 +400,7 @@ pub fn deliver_learned_among(
         } else {
             step
         };
-        let keyed: &PushStrategy = match &about_body {
-            Some(b) if on_centre => b,
-            _ => strategy,
-        };
+        let keyed: &PushStrategy = about_body.as_ref().unwrap_or(strategy);
         let mut stood = None;
         let dir_world = if special {
             let circle = circle_of(&o);
@@ -555,56 +494,26 @@ pub fn deliver_learned_among(
                 b.add(sample.about(body));
             }
         }
-        // Special case next when the push moved the object away from where it was wanted (the
-        // goal, or the path's sub-goal) or off it by more than the re-position angle, or did
-        // not move it at all (the robot lost contact), or — near the boundary — towards the
-        // boundary.
-        // (Along a path, the motion of the enclosing circle's centre, which the path is for.)
+        // Special case next when the push went astray ([`reposition_next`]); along a path it
+        // is the motion of the enclosing circle's centre that counts, the path is for it.
         let went = if on_centre {
             ws.body_centre(&o1) - ws.body_centre(&o0)
         } else {
             moved
         };
-        let off_by = wrap_angle(angle_of(went) - angle_of(to_aim)).abs();
-        special = moved.norm() < p.moved_epsilon
-            || off_by > p.reposition_angle.min(std::f64::consts::FRAC_PI_2)
-            || moved.dot(&bias) < 0.0;
+        let push = Push {
+            before: o0,
+            after: o1,
+            went,
+            wanted: to_aim,
+            bias,
+        };
+        special = reposition_next(&ws, obstacles, p, &push);
         if !special {
             failed.clear();
         } else if let Some(at) = stood {
             failed.push(at);
         }
-    }
-}
-
-/// Watches the distance to the goal for a stall ([`DeliveryParams::stall_time`]).
-struct StallWatch {
-    time: f64,
-    progress: f64,
-    success: f64,
-    best: f64,
-    best_at: f64,
-}
-
-impl StallWatch {
-    fn new(p: &DeliveryParams, now: f64) -> StallWatch {
-        StallWatch {
-            time: p.stall_time,
-            progress: p.stall_progress,
-            success: p.success_radius,
-            best: f64::INFINITY,
-            best_at: now,
-        }
-    }
-
-    /// The object is `dist` from the goal at `now`: has it made no progress for too long?
-    fn stalled(&mut self, dist: f64, now: f64) -> bool {
-        let need = self.progress.min(0.5 * (self.best - self.success));
-        if !self.best.is_finite() || self.best - dist >= need {
-            self.best = dist;
-            self.best_at = now;
-        }
-        self.time > 0.0 && now - self.best_at > self.time
     }
 }
 

@@ -3,6 +3,9 @@
 //! ([`crate::exec::deliver::deliver_learned_among`]) pushing the object towards the path's
 //! moving sub-goal, `lookahead` further along the path than the object
 //! ([`crate::planner::path_follow`]), until it reaches the goal within the success radius.
+//! Near a wall a push that drifted the object towards it is not continued: the robot cannot
+//! stand between the wall and the object to push it back, so the special case re-positions at
+//! once ([`crate::exec::drift`]).
 //!
 //! A leg that makes no progress along its path for `stall_time` (the object caught on a
 //! corner) is a **stall**, never a silent time-out: the robot backs off the object, the path is
@@ -83,6 +86,8 @@ pub fn deliver_among_obstacles(
             time_limit: left,
             stall_time: op.stall_time,
             reposition_angle: op.reposition_angle,
+            wall_near: op.wall_near,
+            wall_reposition_angle: op.wall_reposition_angle,
             ..*params
         };
         let d = deliver_learned_among(
@@ -149,6 +154,8 @@ pub fn deliver_among_obstacles(
                     success_radius: op.subgoal_radius / 2.0,
                     fine_radius: op.subgoal_radius,
                     stall_time: op.stall_time / 2.0,
+                    wall_near: op.wall_near,
+                    wall_reposition_angle: op.wall_reposition_angle,
                     ..*params
                 };
                 let d = deliver_learned_among(io, strategy, t, &side, obstacles, None, sink)?;

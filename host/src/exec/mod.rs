@@ -19,6 +19,8 @@
 pub mod collect;
 pub mod deliver;
 pub mod deliver_path;
+pub mod delivery_params;
+pub mod drift;
 pub mod grabber;
 pub mod grid_snap;
 pub mod io;
@@ -35,6 +37,9 @@ pub mod stable;
 pub mod stable_feedback;
 pub mod stable_replan;
 pub mod stable_start;
+pub mod stall;
+#[cfg(test)]
+mod test_tables;
 pub mod view;
 
 pub use live::{LiveOptions, LiveRobot};

@@ -237,27 +237,9 @@ const APPROACH_GAP: f64 = 0.03;
 mod tests {
     use super::*;
     use crate::exec::deliver::bound_all_radius;
-    use crate::exec::io::Rect;
     use crate::exec::maneuver::angle_of;
+    use crate::exec::test_tables::lau_table;
     use crate::strategy::sample::Sample;
-
-    /// Lau et al.'s 1.6 × 1.2 m table with its boundary 0.1 m in, a robot of 4 cm radius and
-    /// a round object of `radius` about its marker.
-    fn lau_table(radius: f64) -> Workspace {
-        Workspace {
-            table: Rect {
-                min: [0.0, 0.0],
-                max: [1.6, 1.2],
-            },
-            boundary: Rect {
-                min: [0.1, 0.1],
-                max: [1.5, 1.1],
-            },
-            robot_radius: 0.04,
-            object_radius: radius,
-            body: pushbot_world::enclosing_circle::Circle::at_origin(radius),
-        }
-    }
 
     /// A disc-like strategy: pushing from angle a (8 cm out) moves the object towards a + π.
     fn disc_strategy() -> PushStrategy {

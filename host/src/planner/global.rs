@@ -50,6 +50,12 @@ pub struct ObstacleParams {
     /// A push that moves the object off the way to its sub-goal by more than this is followed
     /// by a re-positioning, rad ([`crate::exec::deliver::DeliveryParams::reposition_angle`]).
     pub reposition_angle: f64,
+    /// A push that leaves the object's enclosing circle within this of an obstacle, and nearer
+    /// to it, is followed by a re-positioning once it drifted by
+    /// [`Self::wall_reposition_angle`], m ([`crate::exec::deliver::DeliveryParams::wall_near`]).
+    pub wall_near: f64,
+    /// The re-position angle of a push towards a near wall, rad.
+    pub wall_reposition_angle: f64,
     /// A leg stalls when the object comes no closer to its sub-goal for this long, s.
     pub stall_time: f64,
     /// Recoveries tried before a delivery is given up as stalled.
@@ -67,6 +73,8 @@ impl Default for ObstacleParams {
             lookahead: 0.12,
             subgoal_radius: 0.04,
             reposition_angle: 30f64.to_radians(),
+            wall_near: 0.07,
+            wall_reposition_angle: 10f64.to_radians(),
             stall_time: 60.0,
             max_recoveries: 4,
         }
