@@ -494,17 +494,11 @@ pub fn deliver_learned_among(
                 b.add(sample.about(body));
             }
         }
-        // Special case next when the push went astray ([`reposition_next`]); along a path it
-        // is the motion of the enclosing circle's centre that counts, the path is for it.
-        let went = if on_centre {
-            ws.body_centre(&o1) - ws.body_centre(&o0)
-        } else {
-            moved
-        };
+        // Special case next when the push went astray ([`reposition_next`]).
         let push = Push {
             before: o0,
             after: o1,
-            went,
+            on_centre,
             wanted: to_aim,
             bias,
         };

@@ -2,7 +2,8 @@
 //! the robot re-positions when its last push moved the object away from the goal), with the
 //! tighter rules a delivery among obstacles needs
 //! ([`crate::exec::deliver_path`]): a push that drifted off its wanted way by more than the
-//! re-position angle, and — near a wall — one that drifted towards the wall at all.
+//! re-position angle, and — near a wall — one that drifted towards the wall by more than a
+//! much smaller angle.
 //!
 //! Near a wall the robot cannot stand between the wall and the object, so it cannot push the
 //! object back off it: a drift towards the wall that the next push would continue is not
@@ -23,8 +24,9 @@ pub(crate) struct Push {
     pub before: Pose2,
     /// See [`Push::before`].
     pub after: Pose2,
-    /// The motion that counts (the marker's, or along a path the enclosing circle's centre's).
-    pub went: Vector2<f64>,
+    /// Whether the motion that counts is the enclosing circle's centre's (along a path, which
+    /// is planned for it) rather than the marker's.
+    pub on_centre: bool,
     /// The way that motion was wanted (unit).
     pub wanted: Vector2<f64>,
     /// The boundary guard's pull on the wanted motion (zero away from the boundary).
@@ -44,7 +46,12 @@ pub(crate) fn reposition_next(
     push: &Push,
 ) -> bool {
     let moved = push.after.position() - push.before.position();
-    let off_by = wrap_angle(angle_of(push.went) - angle_of(push.wanted)).abs();
+    let went = if push.on_centre {
+        ws.body_centre(&push.after) - ws.body_centre(&push.before)
+    } else {
+        moved
+    };
+    let off_by = wrap_angle(angle_of(went) - angle_of(push.wanted)).abs();
     moved.norm() < p.moved_epsilon
         || off_by > p.reposition_angle.min(std::f64::consts::FRAC_PI_2)
         || moved.dot(&push.bias) < 0.0
@@ -80,7 +87,7 @@ mod tests {
         Push {
             before,
             after,
-            went,
+            on_centre: false,
             wanted: Vector2::y(),
             bias: Vector2::zeros(),
         }
@@ -112,7 +119,8 @@ mod tests {
         assert!(!reposition_next(&ws, &[], &p, &push(1.22, -1.0)));
         // 40° off is past the re-position angle anywhere.
         let mut wide = push(1.4, 1.0);
-        wide.went = Vector2::new(40f64.to_radians().sin(), 40f64.to_radians().cos());
+        let went = Vector2::new(40f64.to_radians().sin(), 40f64.to_radians().cos());
+        wide.after = Pose2::new(1.4 + 0.04 * went.x, 0.5 + 0.04 * went.y, 0.0);
         assert!(reposition_next(&ws, &wall, &p, &wide));
     }
 }
