@@ -40,6 +40,7 @@ pub mod layout;
 pub mod lens_calib;
 pub mod odometry;
 pub mod pnp;
+mod roi;
 pub mod simsocket;
 pub mod source;
 pub mod tracking;
@@ -52,6 +53,8 @@ use calibration::Calibration;
 use detection::{DetectError, Detection, Detector};
 use frame::Frame;
 use layout::{MarkerLayout, Pose};
+pub use roi::RoiParams;
+use roi::Sighting;
 use tracking::{TrackedPose, Tracker, TrackerParams};
 
 /// One body's pose measured from one detection (before filtering).
@@ -124,53 +127,6 @@ pub struct FrameResult {
 /// How far past the table's edge a body's centre may be measured, metres.
 pub const OFF_TABLE_MARGIN: f64 = 0.05;
 
-/// Tracker-guided regions of interest: between full-frame searches, markers are looked for
-/// only in squares around where each body's marker is predicted to be (constant velocity in
-/// the image from its last two sightings), as real-time trackers do to spend the detector's
-/// time where the targets are.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RoiParams {
-    /// Search the whole frame at least every this many frames (0 or 1: always the whole
-    /// frame, no regions). The whole frame is also searched on the first frame, after a gap
-    /// longer than `max_gap`, and at once whenever a body expected in its region is not found
-    /// there.
-    pub full_every: u32,
-    /// Pixels of margin around a marker's predicted bounding square, on each side (covers
-    /// acceleration between frames and the prediction's error).
-    pub margin_px: f64,
-    /// Seconds since the last sighting beyond which a prediction is not trusted.
-    pub max_gap: f64,
-}
-
-impl Default for RoiParams {
-    fn default() -> Self {
-        RoiParams {
-            full_every: 15,
-            margin_px: 20.0,
-            max_gap: 0.2,
-        }
-    }
-}
-
-impl RoiParams {
-    /// Always the whole frame.
-    pub fn full_frames() -> RoiParams {
-        RoiParams {
-            full_every: 1,
-            ..RoiParams::default()
-        }
-    }
-}
-
-/// Where a body's marker was last seen in the image.
-#[derive(Debug, Clone, Copy)]
-struct Sighting {
-    time: f64,
-    centre: [f64; 2],
-    velocity: [f64; 2],
-    side_px: f64,
-}
-
 /// The whole tracking pipeline: detect, measure, filter.
 pub struct Pipeline {
     detector: Box<dyn Detector>,
@@ -181,6 +137,8 @@ pub struct Pipeline {
     since_full: u32,
     /// Bodies seen in the last frame, by name.
     sightings: Vec<(String, Sighting)>,
+    /// The latest sighting of every body seen so far, by name.
+    last_seen: Vec<(String, Sighting)>,
     /// The camera's lens: detections are undistorted before they are measured.
     lens: Option<pushbot_world::lens::Intrinsics>,
     /// Time of the last whole-frame search at full resolution.
@@ -200,9 +158,6 @@ impl std::fmt::Debug for Pipeline {
     }
 }
 
-/// Regions are squares of a multiple of this many pixels, so a few buffer sizes serve.
-const ROI_STEP: f64 = 16.0;
-
 impl Pipeline {
     /// A pipeline from its parts, with the default regions of interest ([`RoiParams`]).
     pub fn new(
@@ -221,6 +176,7 @@ impl Pipeline {
             roi: RoiParams::default(),
             since_full: 0,
             sightings: Vec::new(),
+            last_seen: Vec::new(),
             lens,
             last_fine: None,
         }
@@ -269,27 +225,10 @@ impl Pipeline {
         {
             return None;
         }
-        let mut out = Vec::with_capacity(self.sightings.len());
-        for (_, s) in &self.sightings {
-            let dt = frame.time - s.time;
-            if !(0.0..=self.roi.max_gap).contains(&dt) {
-                return None;
-            }
-            let centre = [
-                s.centre[0] + s.velocity[0] * dt,
-                s.centre[1] + s.velocity[1] * dt,
-            ];
-            // The marker's bounding square at any heading, plus the margin on each side.
-            let side = s.side_px * std::f64::consts::SQRT_2 + 2.0 * self.roi.margin_px;
-            let side = ((side / ROI_STEP).ceil() * ROI_STEP).min(u32::MAX as f64) as u32;
-            out.push(detection::Region::square_around(
-                centre,
-                side,
-                frame.width,
-                frame.height,
-            ));
-        }
-        Some(out)
+        self.sightings
+            .iter()
+            .map(|(_, s)| s.region(frame.time, frame.width, frame.height, &self.roi))
+            .collect()
     }
 
     /// Detect and measure: in the regions of interest when they are due and find every body
@@ -334,20 +273,43 @@ impl Pipeline {
         }
         let mut dets = self.detector.detect(frame)?;
         let mut ms = self.measure_raw(&dets);
-        // A body of the layout not found: search the whole frame at full resolution too (its
-        // marker may be small or far), at most every FINE_EVERY seconds.
-        let missing = self
+        // A body of the layout not found: search at full resolution too (its marker may be
+        // small or far). Where it was last seen recently enough, only there; otherwise the
+        // whole frame, at most every FINE_EVERY seconds.
+        let missing: Vec<&str> = self
             .layout
             .bodies
             .iter()
-            .any(|b| !ms.iter().any(|m| m.body == b.body));
-        if missing
-            && self
+            .filter(|b| !ms.iter().any(|m| m.body == b.body))
+            .map(|b| b.body.as_str())
+            .collect();
+        let regions: Option<Vec<detection::Region>> = missing
+            .iter()
+            .map(|body| {
+                let (_, s) = self.last_seen.iter().find(|(b, _)| b == body)?;
+                s.region(frame.time, frame.width, frame.height, &self.roi)
+            })
+            .collect();
+        let fine = match regions {
+            _ if missing.is_empty() => Vec::new(),
+            Some(regions) if self.roi.full_every > 1 => {
+                let mut fine = Vec::new();
+                for r in regions {
+                    fine.extend(self.detector.detect_region_fine(frame, r)?);
+                }
+                fine
+            }
+            _ if self
                 .last_fine
-                .is_none_or(|t| !(0.0..FINE_EVERY).contains(&(frame.time - t)))
-        {
-            self.last_fine = Some(frame.time);
-            for d in self.detector.detect_fine(frame)? {
+                .is_none_or(|t| !(0.0..FINE_EVERY).contains(&(frame.time - t))) =>
+            {
+                self.last_fine = Some(frame.time);
+                self.detector.detect_fine(frame)?
+            }
+            _ => Vec::new(),
+        };
+        if !fine.is_empty() {
+            for d in fine {
                 if !dets.iter().any(|e| e.family == d.family && e.id == d.id) {
                     dets.push(d);
                 }
@@ -362,50 +324,25 @@ impl Pipeline {
     fn remember(&mut self, time: f64, dets: &[Detection], ms: &[Measurement]) {
         let mut next = Vec::with_capacity(ms.len());
         for m in ms {
-            let Some(family) = self
-                .layout
-                .bodies
-                .iter()
-                .find(|b| b.body == m.body)
-                .map(|b| b.family)
-            else {
+            let Some(bm) = self.layout.bodies.iter().find(|b| b.body == m.body) else {
                 continue;
             };
             let Some(d) = dets
                 .iter()
-                .filter(|d| d.family == family && d.id == m.marker)
+                .filter(|d| d.family == bm.family && d.id == m.marker)
                 .max_by(|a, b| a.margin.total_cmp(&b.margin))
             else {
                 continue;
             };
-            let c = &d.corners;
-            let side_px = (0..4)
-                .map(|i| {
-                    let (p, q) = (c[i], c[(i + 1) % 4]);
-                    (p[0] - q[0]).hypot(p[1] - q[1])
-                })
-                .sum::<f64>()
-                / 4.0;
-            let velocity = match self.sightings.iter().find(|(b, _)| b == &m.body) {
-                Some((_, s)) if time > s.time && time - s.time <= self.roi.max_gap => {
-                    let dt = time - s.time;
-                    [
-                        (d.centre[0] - s.centre[0]) / dt,
-                        (d.centre[1] - s.centre[1]) / dt,
-                    ]
-                }
-                _ => [0.0, 0.0],
-            };
-            if side_px.is_finite() && d.centre.iter().all(|v| v.is_finite()) {
-                next.push((
-                    m.body.clone(),
-                    Sighting {
-                        time,
-                        centre: d.centre,
-                        velocity,
-                        side_px,
-                    },
-                ));
+            let previous = self.sightings.iter().find(|(b, _)| b == &m.body);
+            if let Some(s) = Sighting::new(time, d, bm.side, previous.map(|(_, s)| s), &self.roi) {
+                next.push((m.body.clone(), s));
+            }
+        }
+        for (body, s) in &next {
+            match self.last_seen.iter_mut().find(|(b, _)| b == body) {
+                Some((_, last)) => *last = *s,
+                None => self.last_seen.push((body.clone(), *s)),
             }
         }
         self.sightings = next;
