@@ -450,3 +450,83 @@ fn the_collection_keeps_the_papers_keys_and_gives_the_strategy_its_own_back() {
     assert_eq!(paper.len(), weighted.len());
     assert!(paper == weighted, "the samples differ");
 }
+
+/// `eval delivery --resume FILE`: a run interrupted after some of its cells (here the file
+/// keeps the header and start A's cell, that cell's robot path altered so that reading it back
+/// shows) runs only the cells missing, and its results are otherwise the whole run's. A run
+/// with a start more adds that start's cell. Another run's file (other `--trials`) is refused
+/// with what differs, and left as it was.
+#[test]
+fn an_evaluation_resumed_from_its_file_runs_only_the_missing_cells() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("cells.jsonl");
+    let run_from = |starts: &str, trials: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_pushbot"))
+            .args([
+                "eval",
+                "delivery",
+                "--scene",
+                "lau-irregular",
+                "--method",
+                "dipole",
+            ])
+            .args([
+                "--start",
+                starts,
+                "--trials",
+                trials,
+                "--sim-camera",
+                "truth",
+                "--json",
+            ])
+            .arg("--resume")
+            .arg(&file)
+            .output()
+            .unwrap()
+    };
+    let run = |trials: &str| run_from("A,B", trials);
+    let results = |out: &std::process::Output| -> Vec<serde_json::Value> {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["scenes"][0]["results"].as_array().unwrap().clone()
+    };
+    let whole = results(&run("2"));
+    assert_eq!(whole.len(), 2);
+    let text = std::fs::read_to_string(&file).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 3, "a header and two cells: {text}");
+    let mut a: serde_json::Value = lines[1..]
+        .iter()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .find(|c| c["result"]["start"] == "A")
+        .unwrap();
+    a["result"]["mean_robot_path_m"] = serde_json::json!(123.0);
+    std::fs::write(&file, format!("{}\n{a}\n", lines[0])).unwrap();
+    let resumed = results(&run("2"));
+    assert_eq!(resumed[0]["start"], "A");
+    assert_eq!(
+        resumed[0]["mean_robot_path_m"], 123.0,
+        "start A was run again"
+    );
+    let mut expected = whole[0].clone();
+    expected["mean_robot_path_m"] = serde_json::json!(123.0);
+    assert_eq!(resumed[0], expected);
+    assert_eq!(resumed[1], whole[1], "start B, run again, differs");
+    assert_eq!(std::fs::read_to_string(&file).unwrap().lines().count(), 3);
+    let more = results(&run_from("A..C", "2"));
+    assert_eq!(more.len(), 3);
+    assert_eq!(more[..2], resumed[..]);
+    assert_eq!(more[2]["start"], "C");
+    assert_eq!(std::fs::read_to_string(&file).unwrap().lines().count(), 4);
+    // Another run's file.
+    let before = std::fs::read(&file).unwrap();
+    let other = run("3");
+    assert!(!other.status.success());
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(err.contains("trials 2 in the file, 3 now"), "{err}");
+    assert_eq!(std::fs::read(&file).unwrap(), before);
+}

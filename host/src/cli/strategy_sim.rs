@@ -14,8 +14,10 @@ use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::experiments::delivery::collect_or_load;
 use crate::experiments::fig11::{fig11_svg, fig11_table};
+use crate::experiments::resume::{CellRecord, Checkpoint, RunKey, SceneKey};
 use crate::experiments::strategy_eval::{
-    LAU_SCENES, Method, SceneEval, StartResult, TrialSetup, evaluate_scene, parse_starts,
+    LAU_SCENES, LabelledRun, Method, SceneEval, StartResult, TrialSetup, evaluate_scene,
+    parse_starts,
 };
 use crate::planner::global::scene_goal;
 use crate::sim::robot::{SimCamera, SimRobot, SimRobotOptions};
@@ -245,6 +247,11 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
                 "--figure 11 runs Lau et al.'s six objects; it takes no --scene ({s})"
             )));
         }
+        (Some(7), _) if a.resume.is_some() => {
+            return Err(CliError::bad_input(
+                "--resume keeps trial cells; --figure 7 collects, and does not resume",
+            ));
+        }
         (Some(7), _) => return super::data_need::run_figure7(global, &a),
         (Some(n), _) => {
             return Err(CliError::bad_input(format!(
@@ -313,13 +320,48 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
             strategy_for(global, &a, name, &setup.scene, setup, several)
         })
         .collect::<Result<Vec<_>, CliError>>()?;
+    let camera_name = a.sim.sim_camera.map_or("truth", |c| match c {
+        SimCameraArg::Rendered => "rendered",
+        SimCameraArg::Truth => "truth",
+    });
+    let scene_keys: Vec<SceneKey> = setups
+        .iter()
+        .zip(&strategies)
+        .map(|(setup, (samples, _))| SceneKey::new(setup, samples))
+        .collect();
+    let checkpoint = match &a.resume {
+        Some(path) => {
+            let key = RunKey::new(a.trials, global.seed, camera_name);
+            let c = Checkpoint::open(path, &key, &scene_keys).map_err(CliError::BadInput)?;
+            if c.cells() > 0 && !global.json {
+                println!(
+                    "{}: {} cells done in an earlier run, not run again",
+                    path.display(),
+                    c.cells()
+                );
+            }
+            Some(c)
+        }
+        None => None,
+    };
     let total = (setups.len() * starts.len() * methods.len() * a.trials) as u64;
     let pb = progress_bar(global, total);
     let mut evals = Vec::new();
     let mut trajectories = Vec::new();
-    for (setup, (samples, collection)) in setups.iter().zip(strategies) {
+    for ((setup, (samples, collection)), key) in setups.iter().zip(strategies).zip(&scene_keys) {
         let scene = &setup.scene;
-        let report = |res: &StartResult| {
+        let resumed = |start: &str, method: Method| {
+            let c = checkpoint.as_ref()?.cell(&scene.name, start, method)?;
+            Some((c.result.clone(), c.first.clone()))
+        };
+        let report = |res: &StartResult, first: Option<&LabelledRun>, resumed: bool| {
+            if let (Some(c), false) = (&checkpoint, resumed) {
+                c.record(&CellRecord {
+                    scene: key.clone(),
+                    result: res.clone(),
+                    first: first.cloned(),
+                })?;
+            }
             pb.inc(res.trials as u64);
             if !global.json {
                 let line = format!(
@@ -340,6 +382,11 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
                     res.stall_recoveries,
                     res.silent_timeouts,
                 );
+                let line = if resumed {
+                    format!("{line} (resumed)")
+                } else {
+                    line
+                };
                 // A hidden bar (output not a terminal) prints nothing.
                 if pb.is_hidden() {
                     println!("{line}");
@@ -347,9 +394,11 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
                     pb.println(line);
                 }
             }
+            Ok(())
         };
-        let (results, runs) =
-            evaluate_scene(setup, &methods, &samples, &starts, a.trials, &report)?;
+        let (results, runs) = evaluate_scene(
+            setup, &methods, &samples, &starts, a.trials, &resumed, &report,
+        )?;
         if !several {
             trajectories.extend(runs);
         }
@@ -392,10 +441,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
             json!({
                 "trials": a.trials,
                 "starts": starts,
-                "camera": a.sim.sim_camera.map_or("truth", |c| match c {
-                    SimCameraArg::Rendered => "rendered",
-                    SimCameraArg::Truth => "truth",
-                }),
+                "camera": camera_name,
                 "figure": a.svg.as_ref().filter(|_| a.figure.is_some()),
                 "scenes": evals,
             })

@@ -8,6 +8,8 @@
 //! - `fig11`: Lau et al. Fig. 11's table and figure from those trials.
 //! - `data_need`, `data_need_figure`: samples collected vs delivery success, for the paper's
 //!   collection and the active one (issue 24, `eval delivery --figure 7`).
+//! - `resume`: the file of finished cells that lets such an evaluation be interrupted and
+//!   resumed (`eval delivery --resume`).
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
 //! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
@@ -30,6 +32,8 @@ pub mod fig11;
 #[cfg(feature = "sim")]
 pub mod link_bench;
 pub mod rearrange_bench;
+#[cfg(feature = "sim")]
+pub mod resume;
 #[cfg(feature = "sim")]
 pub mod stable_trials;
 #[cfg(feature = "sim")]

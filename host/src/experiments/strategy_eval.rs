@@ -203,17 +203,29 @@ pub struct SceneEval {
 /// One trial's robot and object poses after every step, labelled "START METHOD".
 pub type LabelledRun = (String, Vec<(Pose2, Pose2)>);
 
+/// One cell's results and its first trial's trajectory.
+pub type Cell = (StartResult, Option<LabelledRun>);
+
+/// The cells of an earlier run, by start and method ([`evaluate_scene`]).
+pub type ResumedCells<'a> = dyn Fn(&str, Method) -> Option<Cell> + Sync + 'a;
+
+/// Called with each cell as it is done, and whether it was resumed ([`evaluate_scene`]).
+pub type CellReport<'a> =
+    dyn Fn(&StartResult, Option<&LabelledRun>, bool) -> Result<()> + Sync + 'a;
+
 /// Trials of every method from every start of one scene (Lau et al. §V), the cells (start ×
-/// method) on all cores: the results in the order start × method, each handed to `report` as
-/// its cell is done (in any order), and the first trial's trajectory of each (labelled "START
-/// METHOD") for the figure.
+/// method) on all cores: the results in the order start × method, and the first trial's
+/// trajectory of each (labelled "START METHOD") for the figure. A cell `resumed` returns (read
+/// back from an earlier run, [`super::resume`]) is not run again; every cell, run or resumed,
+/// is handed to `report` as it is done (in any order), with whether it was resumed.
 pub fn evaluate_scene(
     setup: &TrialSetup,
     methods: &[Method],
     samples: &[Sample],
     starts: &[String],
     trials: usize,
-    report: &(dyn Fn(&StartResult) + Sync),
+    resumed: &ResumedCells<'_>,
+    report: &CellReport<'_>,
 ) -> Result<(Vec<StartResult>, Vec<LabelledRun>)> {
     use rayon::prelude::*;
     let cells: Vec<(&String, Method)> = starts
@@ -223,14 +235,17 @@ pub fn evaluate_scene(
     let done = cells
         .par_iter()
         .map(|(s, m)| {
+            if let Some((res, first)) = resumed(s, *m) {
+                report(&res, first.as_ref(), true)?;
+                return Ok((res, first));
+            }
             let (res, runs) = run_start(setup, *m, samples, s, trials)?;
-            report(&res);
-            Ok((
-                res,
-                runs.into_iter()
-                    .next()
-                    .map(|first| (format!("{s} {m:?}"), first.trajectory)),
-            ))
+            let first = runs
+                .into_iter()
+                .next()
+                .map(|first| (format!("{s} {m:?}"), first.trajectory));
+            report(&res, first.as_ref(), false)?;
+            Ok((res, first))
         })
         .collect::<Result<Vec<_>>>()?;
     let mut results = Vec::with_capacity(done.len());

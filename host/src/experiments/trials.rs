@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use crate::exec::deliver::{Delivery, Failure};
 
 /// A delivery method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Algorithm 2 with the learned pushing strategy.
@@ -17,7 +17,7 @@ pub enum Method {
 }
 
 /// The results of one method from one start position.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StartResult {
     /// Start position name (A–F).
     pub start: String,
