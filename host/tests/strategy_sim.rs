@@ -451,6 +451,15 @@ fn the_collection_keeps_the_papers_keys_and_gives_the_strategy_its_own_back() {
     assert!(paper == weighted, "the samples differ");
 }
 
+/// The command succeeded; its error output shown if not.
+fn assert_ran(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// `eval delivery --resume FILE`: a run interrupted after some of its cells (here the file
 /// keeps the header and start A's cell, that cell's robot path altered so that reading it back
 /// shows) runs only the cells missing, and its results are otherwise the whole run's. A run
@@ -486,11 +495,7 @@ fn an_evaluation_resumed_from_its_file_runs_only_the_missing_cells() {
     };
     let run = |trials: &str| run_from("A,B", trials);
     let results = |out: &std::process::Output| -> Vec<serde_json::Value> {
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ran(out);
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         v["scenes"][0]["results"].as_array().unwrap().clone()
     };
@@ -529,4 +534,48 @@ fn an_evaluation_resumed_from_its_file_runs_only_the_missing_cells() {
     let err = String::from_utf8_lossy(&other.stderr);
     assert!(err.contains("trials 2 in the file, 3 now"), "{err}");
     assert_eq!(std::fs::read(&file).unwrap(), before);
+}
+
+/// `eval delivery --trace-dir DIR` writes every trial it runs: a JSON file with its steps
+/// (as many as its trajectory) and a drawing, named by scene, start, method and trial.
+#[test]
+fn every_trial_run_is_traced_to_the_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let traces = dir.path().join("traces");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pushbot"))
+        .args(["eval", "delivery", "--scene", "lau-irregular", "--method"])
+        .args([
+            "dipole",
+            "--start",
+            "A,B",
+            "--trials",
+            "2",
+            "--sim-camera",
+            "truth",
+        ])
+        .args(["--json", "--trace-dir"])
+        .arg(&traces)
+        .output()
+        .unwrap();
+    assert_ran(&out);
+    let mut names: Vec<String> = std::fs::read_dir(&traces)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let want: Vec<String> = ["A", "B"]
+        .iter()
+        .flat_map(|s| (0..2).map(move |t| format!("lau-irregular-{s}-dipole-{t:03}")))
+        .flat_map(|n| [format!("{n}.json"), format!("{n}.svg")])
+        .collect();
+    assert_eq!(names, want);
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(traces.join("lau-irregular-B-dipole-001.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(v["start"], "B");
+    assert_eq!(v["trial"], 1);
+    let steps = v["trajectory"].as_array().unwrap().len();
+    assert!(steps > 10, "{steps} steps");
+    assert_eq!(v["delivery"]["success"], true);
 }

@@ -280,6 +280,12 @@ pub struct DeliveryArgs {
     /// 50 --strategy-dir strategies --resume fig11-cells.jsonl`
     #[arg(long, value_name = "FILE.jsonl", conflicts_with = "hil")]
     pub resume: Option<PathBuf>,
+    /// Write every trial run into this folder: `SCENE-START-METHOD-TRIAL.json` (how it went,
+    /// the robot's and the object's pose after every step) and an SVG drawing of it (tracks,
+    /// the object's outline along the way, the stalls recovered). Example: `pushbot eval
+    /// delivery --scene lau-zigzag-l --method learned --trials 20 --trace-dir traces`
+    #[arg(long, value_name = "DIR", conflicts_with = "hil")]
+    pub trace_dir: Option<PathBuf>,
     #[command(flatten)]
     pub active: ActiveArgs,
     #[command(flatten)]

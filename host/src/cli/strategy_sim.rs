@@ -12,6 +12,7 @@ use super::progress_bar;
 use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs};
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
+use crate::exec::deliver::Delivery;
 use crate::experiments::delivery::collect_or_load;
 use crate::experiments::fig11::{fig11_svg, fig11_table};
 use crate::experiments::resume::{CellRecord, Checkpoint, RunKey, SceneKey};
@@ -19,6 +20,7 @@ use crate::experiments::strategy_eval::{
     LAU_SCENES, LabelledRun, Method, SceneEval, StartResult, TrialSetup, evaluate_scene,
     parse_starts,
 };
+use crate::experiments::trace::TraceDir;
 use crate::planner::global::scene_goal;
 use crate::sim::robot::{SimCamera, SimRobot, SimRobotOptions};
 use crate::strategy::figures;
@@ -344,6 +346,10 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
         }
         None => None,
     };
+    let trace = match &a.trace_dir {
+        Some(dir) => Some(TraceDir::create(dir).map_err(CliError::BadInput)?),
+        None => None,
+    };
     let total = (setups.len() * starts.len() * methods.len() * a.trials) as u64;
     let pb = progress_bar(global, total);
     let mut evals = Vec::new();
@@ -354,7 +360,15 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
             let c = checkpoint.as_ref()?.cell(&scene.name, start, method)?;
             Some((c.result.clone(), c.first.clone()))
         };
-        let report = |res: &StartResult, first: Option<&LabelledRun>, resumed: bool| {
+        let goal = setup.goal()?;
+        let outline = object_outline(scene, setup.object.as_deref());
+        let report = |res: &StartResult, first: Option<&LabelledRun>, runs: Option<&[Delivery]>| {
+            if let (Some(t), Some(runs)) = (&trace, runs) {
+                for (k, d) in runs.iter().enumerate() {
+                    t.write(scene, goal, &outline, &res.start, res.method, k, d)?;
+                }
+            }
+            let resumed = runs.is_none();
             if let (Some(c), false) = (&checkpoint, resumed) {
                 c.record(&CellRecord {
                     scene: key.clone(),

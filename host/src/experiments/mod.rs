@@ -10,6 +10,7 @@
 //!   collection and the active one (issue 24, `eval delivery --figure 7`).
 //! - `resume`: the file of finished cells that lets such an evaluation be interrupted and
 //!   resumed (`eval delivery --resume`).
+//! - `trace`: every trial's poses and a drawing of it (`eval delivery --trace-dir`).
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
 //! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
@@ -38,4 +39,6 @@ pub mod resume;
 pub mod stable_trials;
 #[cfg(feature = "sim")]
 pub mod strategy_eval;
+#[cfg(feature = "sim")]
+pub mod trace;
 pub mod trials;

@@ -209,15 +209,16 @@ pub type Cell = (StartResult, Option<LabelledRun>);
 /// The cells of an earlier run, by start and method ([`evaluate_scene`]).
 pub type ResumedCells<'a> = dyn Fn(&str, Method) -> Option<Cell> + Sync + 'a;
 
-/// Called with each cell as it is done, and whether it was resumed ([`evaluate_scene`]).
+/// Called with each cell as it is done, with its trials' deliveries (`None` for a cell
+/// resumed, [`evaluate_scene`]).
 pub type CellReport<'a> =
-    dyn Fn(&StartResult, Option<&LabelledRun>, bool) -> Result<()> + Sync + 'a;
+    dyn Fn(&StartResult, Option<&LabelledRun>, Option<&[Delivery]>) -> Result<()> + Sync + 'a;
 
 /// Trials of every method from every start of one scene (Lau et al. §V), the cells (start ×
 /// method) on all cores: the results in the order start × method, and the first trial's
 /// trajectory of each (labelled "START METHOD") for the figure. A cell `resumed` returns (read
 /// back from an earlier run, [`super::resume`]) is not run again; every cell, run or resumed,
-/// is handed to `report` as it is done (in any order), with whether it was resumed.
+/// is handed to `report` as it is done (in any order), with its trials if it was run.
 pub fn evaluate_scene(
     setup: &TrialSetup,
     methods: &[Method],
@@ -236,15 +237,14 @@ pub fn evaluate_scene(
         .par_iter()
         .map(|(s, m)| {
             if let Some((res, first)) = resumed(s, *m) {
-                report(&res, first.as_ref(), true)?;
+                report(&res, first.as_ref(), None)?;
                 return Ok((res, first));
             }
             let (res, runs) = run_start(setup, *m, samples, s, trials)?;
             let first = runs
-                .into_iter()
-                .next()
-                .map(|first| (format!("{s} {m:?}"), first.trajectory));
-            report(&res, first.as_ref(), false)?;
+                .first()
+                .map(|first| (format!("{s} {m:?}"), first.trajectory.clone()));
+            report(&res, first.as_ref(), Some(&runs))?;
             Ok((res, first))
         })
         .collect::<Result<Vec<_>>>()?;

@@ -56,13 +56,9 @@ pub fn strategy_svg(samples: &[Sample], outline: &[[f64; 2]]) -> String {
     d.to_string()
 }
 
-/// Trajectories of robot (blue) and object marker (red) on the scene's table, one group per
-/// labelled run, with the obstacles, the goal and the start positions.
-pub fn trajectories_svg(
-    runs: &[(String, Vec<(Pose2, Pose2)>)],
-    scene: &Scene,
-    goal: Vector2<f64>,
-) -> String {
+/// The scene's table at 2 mm a pixel, its obstacles (grey) and the `goal` (a green circle): the
+/// ground delivery figures are drawn on, and the frame that maps the table onto it.
+pub fn table_doc(scene: &Scene, goal: Vector2<f64>) -> (Frame, Doc) {
     let f = Frame::table(scene.table.width, scene.table.height, 500.0);
     let mut d = Doc::for_frame(&f);
     d.background(&Style::new().fill("white").stroke("black"));
@@ -74,6 +70,17 @@ pub fn trajectories_svg(
         f.length(0.022),
         &Style::outline("green", 2.0),
     );
+    (f, d)
+}
+
+/// Trajectories of robot (blue) and object marker (red) on the scene's table, one group per
+/// labelled run, with the obstacles, the goal and the start positions.
+pub fn trajectories_svg(
+    runs: &[(String, Vec<(Pose2, Pose2)>)],
+    scene: &Scene,
+    goal: Vector2<f64>,
+) -> String {
+    let (f, mut d) = table_doc(scene, goal);
     for p in &scene.positions {
         let at = f.map([p.pose.x, p.pose.y]);
         d.text(at, &p.name, &Style::new().font_size(14.0));
