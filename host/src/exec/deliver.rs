@@ -92,6 +92,9 @@ pub struct Delivery {
     pub shortest_path: Option<f64>,
     /// Final marker–goal distance, m.
     pub final_distance: f64,
+    /// The global paths of the object's body planned, one per leg (among obstacles), table
+    /// frame, m.
+    pub paths: Vec<Vec<[f64; 2]>>,
     /// Robot and object poses after every step (Fig. 8).
     #[serde(skip)]
     pub trajectory: Vec<(Pose2, Pose2)>,
@@ -112,6 +115,7 @@ impl Delivery {
             body_path: 0.0,
             shortest_path: None,
             final_distance,
+            paths: Vec::new(),
             trajectory: Vec::new(),
         }
     }
@@ -269,6 +273,7 @@ fn finish(
         body_path: path_len(&trajectory, |t| ws.body_centre(&t.1)),
         shortest_path: None,
         final_distance: (goal - o.position()).norm(),
+        paths: Vec::new(),
         trajectory,
     }
 }

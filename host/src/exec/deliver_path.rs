@@ -76,8 +76,9 @@ pub fn deliver_among_obstacles(
         let shown: Vec<[f64; 2]> = path.iter().map(|v| [v.x, v.y]).collect();
         io.show_path(&shown);
         if first_path.is_empty() {
-            first_path = shown;
+            first_path.clone_from(&shown);
         }
+        all.paths.push(shown);
         let Some(mut follow) = PathFollower::new(&path, lookahead) else {
             all.failure = Some(Failure::NoPath);
             break;

@@ -2,9 +2,10 @@
 //! where a long path, a stall or a time-out came from (Lau et al. §V's trials, one by one). For
 //! every trial run, `SCENE-START-METHOD-TRIAL.json` holds how it went (the [`Delivery`], with
 //! the robot's and the object's pose after every step) and `….svg` draws it: the table, the
-//! obstacles and the goal, the robot's track (blue), the object's marker track (red), its
-//! outline every few steps (fading in as the trial goes on), and each stall recovered (orange,
-//! with what was tried).
+//! obstacles and the goal, the global path planned for each leg (dashed green, the later ones
+//! darker), the robot's track (blue), the object's marker track (red), its outline every few
+//! steps (fading in as the trial goes on), and each stall recovered (orange, with what was
+//! tried).
 
 use std::path::{Path, PathBuf};
 
@@ -102,6 +103,17 @@ pub fn trial_svg(
     title: &str,
 ) -> String {
     let (f, mut doc) = table_doc(scene, goal);
+    // The paths planned, one per leg, the later ones darker.
+    for (k, path) in d.paths.iter().enumerate() {
+        let shade = 0.3 + 0.6 * (k + 1) as f64 / d.paths.len() as f64;
+        doc.polyline(
+            &f.map_all(path),
+            &Style::outline("#2a2", 1.5)
+                .dash("6 4")
+                .opacity(shade)
+                .tip(&format!("path planned for leg {}", k + 1)),
+        );
+    }
     let n = d.trajectory.len();
     let every = n.div_ceil(OUTLINES).max(1);
     for (k, (_, o)) in d.trajectory.iter().enumerate() {
@@ -182,6 +194,7 @@ mod tests {
                 )
             })
             .collect();
+        d.paths = vec![vec![[0.3, 0.5], [0.8, 0.5], [1.0, 0.5]]; 3];
         d.recoveries = vec![
             Recovery {
                 t: 100.0,
@@ -196,6 +209,7 @@ mod tests {
         let drawn = svg.matches(r##"stroke="#a33""##).count();
         assert!((20..=OUTLINES + 1).contains(&drawn), "{drawn} outlines");
         assert_eq!(svg.matches(r#"fill="orange""#).count(), 2);
+        assert_eq!(svg.matches("path planned for leg").count(), 3);
         assert!(svg.contains("Stalled, 321.0 s"), "{svg}");
         let dir = tempfile::tempdir().unwrap();
         let t = TraceDir::create(&dir.path().join("a/b")).unwrap();
@@ -218,6 +232,7 @@ mod tests {
                 .unwrap();
         assert_eq!(v["trajectory"].as_array().unwrap().len(), 100);
         assert_eq!(v["delivery"]["recoveries"].as_array().unwrap().len(), 2);
+        assert_eq!(v["delivery"]["paths"].as_array().unwrap().len(), 3);
         assert!(base.with_extension("svg").exists());
     }
 }

@@ -157,6 +157,7 @@ mod tests {
             robot_path: 2.0,
             shortest_path: Some(1.0),
             final_distance: 0.01,
+            paths: Vec::new(),
             trajectory: Vec::new(),
         }
     }
