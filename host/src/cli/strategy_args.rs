@@ -274,9 +274,9 @@ pub struct DeliveryArgs {
     #[arg(long, default_value_t = 25)]
     pub every: usize,
     /// Keep every finished cell (scene × start × method) in this JSON-lines file as it is
-    /// done; run again with the same file (and the same arguments and strategies) and the
-    /// cells already in it are not run again. For evaluations of hours: an interruption loses
-    /// only the cells that were running. Example: `pushbot eval delivery --figure 11 --trials
+    /// done; run again with the same file (the same --trials, --seed, camera and strategies;
+    /// starts, methods or scenes may be added) and the cells already in it are not run again.
+    /// For evaluations of hours: an interruption loses only the cells that were running. Example: `pushbot eval delivery --figure 11 --trials
     /// 50 --strategy-dir strategies --resume fig11-cells.jsonl`
     #[arg(long, value_name = "FILE.jsonl", conflicts_with = "hil")]
     pub resume: Option<PathBuf>,
