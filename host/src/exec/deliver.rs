@@ -354,7 +354,9 @@ pub fn deliver_learned_among(
             Some(f) => {
                 let a = f.aim(centre);
                 if (a.subgoal - goal).norm() > 1e-9 {
-                    (true, a.subgoal, a.left)
+                    // Over the path's last stretch its end blends into where the body is
+                    // when the marker is at the goal ([`PathFollower::shifted`]).
+                    (true, f.shifted(&a, centre - o.position()), a.left)
                 } else {
                     if !last_leg {
                         last_leg = true;

@@ -79,7 +79,9 @@ pub fn deliver_among_obstacles(
             first_path.clone_from(&shown);
         }
         all.paths.push(shown);
-        let Some(mut follow) = PathFollower::new(&path, lookahead) else {
+        let Some(mut follow) =
+            PathFollower::new(&path, lookahead).map(|f| f.with_end_blend(op.end_blend))
+        else {
             all.failure = Some(Failure::NoPath);
             break;
         };
@@ -121,10 +123,13 @@ pub fn deliver_among_obstacles(
             lookahead = (op.lookahead / 2f64.powi(stalls_in_a_row)).max(op.subgoal_radius);
             // A second stall in a row: the robot cannot get behind the object for the way the
             // path wants; push it a little from a side it can reach, then plan again.
+            // Never further than the marker is from the goal: a stall beside the goal (the
+            // marker a few centimetres off it) is nudged, not pushed away.
+            let reach = SIDE_STEP.min((goal - o).norm()).max(MIN_SIDE_STEP);
             let aside = (stalls_in_a_row > 1)
                 .then(|| {
                     let bound_all = bound_all_circle(&ws, &marker, params.bound_all_margin, false);
-                    side_step(io, obstacles, strategy, sub - centre, op, &bound_all)
+                    side_step(io, obstacles, strategy, sub - centre, reach, op, &bound_all)
                 })
                 .flatten();
             let action = match aside {
@@ -152,7 +157,7 @@ pub fn deliver_among_obstacles(
                 let left = params.time_limit - (io.time() - start);
                 let side = DeliveryParams {
                     time_limit: left.min(op.stall_time),
-                    success_radius: op.subgoal_radius / 2.0,
+                    success_radius: (op.subgoal_radius / 2.0).min(reach / 2.0),
                     fine_radius: op.subgoal_radius,
                     stall_time: op.stall_time / 2.0,
                     wall_near: op.wall_near,
@@ -200,8 +205,12 @@ fn back_off(io: &mut dyn RobotIo, op: &ObstacleParams) -> Result<()> {
     Ok(())
 }
 
-/// How far a recovery pushes the object aside, m.
+/// How far a recovery pushes the object aside, m: at most this, and no further than the
+/// marker is from the goal, but at least [`MIN_SIDE_STEP`].
 const SIDE_STEP: f64 = 0.08;
+
+/// The shortest push aside, m: a few of the fine pushes' steps.
+const MIN_SIDE_STEP: f64 = 0.02;
 
 /// A recorded push counts for a direction aside when it moved the object within this of it,
 /// rad (the sixteen directions are 22.5° apart).
@@ -218,6 +227,7 @@ fn side_step(
     obstacles: &[Vec<[f64; 2]>],
     strategy: &PushStrategy,
     want: Vector2<f64>,
+    reach: f64,
     op: &ObstacleParams,
     bound_all: &BoundAll,
 ) -> Option<Vector2<f64>> {
@@ -238,9 +248,9 @@ fn side_step(
             Vector2::new(a.cos(), a.sin())
         })
         .filter(|d| {
-            let t = here + d * SIDE_STEP;
+            let t = here + d * reach;
             let local = o.vector_to_local(*d);
-            ws.boundary.contains(o.position() + d * SIDE_STEP)
+            ws.boundary.contains(o.position() + d * reach)
                 && clearance(t, obstacles) >= keep
                 && strategy
                     .special([local.x, local.y])
@@ -251,5 +261,5 @@ fn side_step(
                     .any(|rep| approach_radius(ws, &keep_clear, o, from, &rep, bound_all).is_some())
         })
         .max_by(|a, b| a.dot(&want).total_cmp(&b.dot(&want)))
-        .map(|d| o.position() + d * SIDE_STEP)
+        .map(|d| o.position() + d * reach)
 }

@@ -44,6 +44,12 @@ pub struct ObstacleParams {
     /// How far along the path beyond the object its moving sub-goal is, m
     /// ([`crate::planner::path_follow`]).
     pub lookahead: f64,
+    /// Over this much of the path before its end, m, the moving sub-goal shifts by degrees
+    /// from the path's end (planned for the body's centre at the goal) to where the body's
+    /// centre is when the marker is at the goal ([`crate::planner::path_follow::PathFollower::shifted`]):
+    /// for an object marked off its middle (the L-shape's marker is 6 cm from its body's
+    /// centre) the body is not first carried to the goal and then back.
+    pub end_blend: f64,
     /// A recovery's push aside counts as done within this distance, m; the shortest
     /// look-ahead.
     pub subgoal_radius: f64,
@@ -71,6 +77,7 @@ impl Default for ObstacleParams {
             room_penalty: 1,
             behind_penalty: 8,
             lookahead: 0.12,
+            end_blend: 0.15,
             subgoal_radius: 0.04,
             reposition_angle: 30f64.to_radians(),
             wall_near: 0.07,

@@ -18,6 +18,8 @@ pub struct Aim {
     pub left: f64,
     /// The object's distance from the path, m.
     pub off_path: f64,
+    /// The way along the path from the sub-goal to its end, m (0 once the sub-goal is the end).
+    pub to_end: f64,
 }
 
 /// A path followed by pure pursuit, with the progress made along it so far.
@@ -29,6 +31,7 @@ pub struct PathFollower {
     /// Arc length of the object's last projection.
     at: f64,
     lookahead: f64,
+    end_blend: f64,
 }
 
 /// How far behind its last projection the object's projection may fall, m (it was pushed
@@ -58,7 +61,34 @@ impl PathFollower {
             arc,
             at: 0.0,
             lookahead,
+            end_blend: 0.0,
         })
+    }
+
+    /// The same follower with an end blend of `blend` m ([`PathFollower::shifted`]); 0 (the
+    /// default) shifts the end only once the sub-goal is the end itself.
+    pub fn with_end_blend(self, blend: f64) -> PathFollower {
+        PathFollower {
+            end_blend: blend.max(0.0),
+            ..self
+        }
+    }
+
+    /// The sub-goal of `aim` moved by `shift`: in full once the sub-goal is the path's end,
+    /// not at all while the end blend or more of the path lies beyond it, and in proportion
+    /// between. The path is planned for one point of the object (its body's centre) but the
+    /// goal is for another (its marker), `shift` from it: the point planned for is wanted at
+    /// the goal plus `shift`, which turns as the object does. Shifting the last stretch
+    /// gradually joins the path to that end without a turn where the sub-goal reaches it.
+    pub fn shifted(&self, aim: &Aim, shift: Vector2<f64>) -> Vector2<f64> {
+        let k = if self.end_blend > 0.0 {
+            (1.0 - aim.to_end / self.end_blend).clamp(0.0, 1.0)
+        } else if aim.to_end > 0.0 {
+            0.0
+        } else {
+            1.0
+        };
+        aim.subgoal + shift * k
     }
 
     /// Length of the path, m.
@@ -118,6 +148,7 @@ impl PathFollower {
         let ahead = (self.lookahead - off_path).max(self.lookahead / 3.0);
         Aim {
             subgoal: self.point_at(s + ahead),
+            to_end: (self.length() - s - ahead).max(0.0),
             left: off_path + (self.length() - s),
             off_path,
         }
@@ -147,6 +178,27 @@ mod tests {
         f.aim(v(0.8, 0.0));
         let a = f.aim(v(0.97, 0.0));
         assert_eq!(a.subgoal, v(1.0, 0.0));
+        assert_eq!(a.to_end, 0.0);
+    }
+
+    /// The end is shifted in full at the end, not at all a blend or more before it, half way
+    /// half; with no blend only at the end.
+    #[test]
+    fn the_shifted_end_blends_in_over_the_last_stretch() {
+        let path = [v(0.0, 0.0), v(1.0, 0.0)];
+        let mut f = PathFollower::new(&path, 0.1).unwrap().with_end_blend(0.2);
+        let shift = v(0.0, 0.06);
+        for (x, k) in [(0.5, 0.0), (0.7, 0.0), (0.8, 0.5), (0.95, 1.0)] {
+            let a = f.aim(v(x, 0.0));
+            let want = a.subgoal + shift * k;
+            assert!((f.shifted(&a, shift) - want).norm() < 1e-9, "{x}: {a:?}");
+        }
+        let mut plain = PathFollower::new(&path, 0.1).unwrap();
+        plain.aim(v(0.5, 0.0));
+        let a = plain.aim(v(0.85, 0.0));
+        assert_eq!(plain.shifted(&a, shift), a.subgoal);
+        let a = plain.aim(v(0.95, 0.0));
+        assert_eq!(plain.shifted(&a, shift), v(1.0, 0.06));
     }
 
     #[test]
