@@ -58,8 +58,12 @@ const SPECIAL_TURNS_DEG: [f64; 13] = [
 /// or the stand point already failed ([`Standing::failed`]), the candidates are the
 /// regression's answers for the wanted direction turned either way ([`SPECIAL_TURNS_DEG`])
 /// and the recorded pushes that moved the object within 90° of it, nearest direction first;
-/// the first that works wins, else the untouched one. On a clear table it is the paper's
-/// re-positioning as it is.
+/// the first that works wins, else the untouched one. On a clear table every stand point can
+/// be reached, so it is the paper's re-positioning except that a stand point whose push failed
+/// is not stood on again while another is fresh: the paper's stands the robot where it failed
+/// again and again, and a snake turned about a point beside the goal, walked round after every
+/// push, orbits the goal 4 cm from it until the time runs out (4 of 50 from Fig. 10's E with
+/// the rendered camera).
 pub(crate) fn reachable_reposition(
     strategy: &PushStrategy,
     ws: &Workspace,
@@ -76,16 +80,19 @@ pub(crate) fn reachable_reposition(
         radius,
         reachable: true,
     };
-    if obstacles.is_empty() {
-        return Some(stand(first, bound_all.radius));
-    }
     let object = outline_on_table(robot.outline, o);
     let keep_clear = Around {
         obstacles,
         object: &object,
     };
-    let approach_radius =
-        |rep: &Reposition| approach_radius(ws, &keep_clear, o, robot.from, rep, bound_all);
+    // On a clear table every stand point is reached from the bound-all circle.
+    let approach_radius = |rep: &Reposition| {
+        if obstacles.is_empty() {
+            Some(bound_all.radius)
+        } else {
+            approach_radius(ws, &keep_clear, o, robot.from, rep, bound_all)
+        }
+    };
     let fresh = |rep: &Reposition| {
         robot
             .failed
@@ -120,7 +127,7 @@ pub(crate) fn reachable_reposition(
             Some(Stand {
                 rep: first,
                 radius: bound_all.radius,
-                reachable: false,
+                reachable: obstacles.is_empty(),
             })
         })
 }
