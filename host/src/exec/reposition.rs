@@ -380,17 +380,10 @@ mod tests {
         assert_eq!(radius, bound_all);
     }
 
-    /// An object pressed against a wall on its left, wanted to the right. Every push the
-    /// strategy knows that moves it rightwards stands the robot on its left, in the wall, but
-    /// for three pushes from below that turned it and moved it up and to the right. The
-    /// regression (its k nearest pushes are always from the left) stands the robot in the wall
-    /// for every turned direction; the re-positioning stands it where one of the pushes from
-    /// below did. Once that stand point failed it is not offered again.
-    #[test]
-    fn against_a_wall_a_recorded_push_from_a_side_the_robot_can_reach_is_used() {
-        let ws = lau_table(0.06);
-        let walls = vec![vec![[0.6, 0.0], [0.7, 0.0], [0.7, 1.2], [0.6, 1.2]]];
-        let o = Pose2::new(0.76, 0.5, 0.0);
+    /// Pushes from the object's left, at heights −3…3 cm, that moved it right and fanned out
+    /// over ±80° (each direction three times), and three from below (the point returned) that
+    /// moved it 55° from the right.
+    fn from_left_and_below() -> (PushStrategy, [f64; 2]) {
         let mut samples = Vec::new();
         // From the left, at heights −3…3 cm: the object goes right and turns, so its motion
         // fans out over ±80°; each direction is pushed three times.
@@ -421,6 +414,60 @@ mod tests {
             samples,
             crate::strategy::regression::KernelParams::default(),
         );
+        (strategy, below)
+    }
+
+    /// On a clear table the paper's answer is stood on, until its push failed: then another
+    /// answer is, reached from the bound-all circle (the snake's orbit round the goal).
+    #[test]
+    fn on_a_clear_table_a_failed_stand_point_is_not_stood_on_again() {
+        let ws = lau_table(0.06);
+        let o = Pose2::new(0.76, 0.5, 0.0);
+        let (strategy, _) = from_left_and_below();
+        let circle = BoundAll {
+            centre: o.position(),
+            radius: 0.06 + 0.08 + 0.02,
+        };
+        let first = strategy.special([1.0, 0.0]).expect("an answer");
+        let stand_with = |failed: &[[f64; 2]]| {
+            let robot = Standing {
+                from: Vector2::new(1.2, 0.2),
+                failed,
+                outline: &[],
+            };
+            reachable_reposition(&strategy, &ws, &[], &o, robot, [1.0, 0.0], &circle)
+                .expect("a re-positioning")
+        };
+        let stand = stand_with(&[]);
+        assert_eq!(stand.rep, first);
+        assert!(
+            stand.reachable && stand.radius == circle.radius,
+            "{stand:?}"
+        );
+        let stand = stand_with(&[first.p]);
+        let moved = (stand.rep.p[0] - first.p[0]).hypot(stand.rep.p[1] - first.p[1]);
+        assert!(
+            moved > FAILED_STAND_RADIUS,
+            "stood again where it failed: {stand:?}"
+        );
+        assert!(
+            stand.reachable && stand.radius == circle.radius,
+            "{stand:?}"
+        );
+    }
+
+    /// An object pressed against a wall on its left, wanted to the right. Every push the
+    /// strategy knows that moves it rightwards stands the robot on its left, in the wall, but
+    /// for three pushes from below that turned it and moved it up and to the right. The
+    /// regression (its k nearest pushes are always from the left) stands the robot in the wall
+    /// for every turned direction; the re-positioning stands it where one of the pushes from
+    /// below did. Once that stand point failed it is not offered again.
+    #[test]
+    fn against_a_wall_a_recorded_push_from_a_side_the_robot_can_reach_is_used() {
+        let ws = lau_table(0.06);
+        let walls = vec![vec![[0.6, 0.0], [0.7, 0.0], [0.7, 1.2], [0.6, 1.2]]];
+        let o = Pose2::new(0.76, 0.5, 0.0);
+        let (strategy, below) = from_left_and_below();
         let circle = BoundAll {
             centre: o.position(),
             radius: 0.06 + 0.08 + 0.02,
