@@ -23,6 +23,7 @@ use crate::exec::deliver::{
 use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{Around, outline_on_table};
 use crate::exec::reposition::{BoundAll, approach_radius, recorded_pushes};
+use crate::planner::detour::shortcut_object_path;
 use crate::planner::global::{ObstacleParams, clearance, plan_object_path};
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::regression::PushStrategy;
@@ -73,6 +74,7 @@ pub fn deliver_among_obstacles(
             all.failure = Some(Failure::NoPath);
             break;
         };
+        let path = shortcut_object_path(&body_ws, obstacles, &path, op);
         let shown: Vec<[f64; 2]> = path.iter().map(|v| [v.x, v.y]).collect();
         io.show_path(&shown);
         if first_path.is_empty() {

@@ -192,13 +192,7 @@ pub fn plan_object_path(
         })
         .collect();
     let at = |(i, j): (i32, i32)| factor[(j * nx + i) as usize];
-    // Can the robot stand behind an object at `x` to push it along `d`?
-    let behind = ws.object_radius + ws.robot_radius + p.room_margin;
-    let pushable = |x: Vector2<f64>, d: Vector2<f64>| {
-        p.behind_penalty <= 1
-            || d.try_normalize(1e-12)
-                .is_none_or(|u| robot_fits(ws, obstacles, x - u * behind))
-    };
+    let pushable = |x: Vector2<f64>, d: Vector2<f64>| pushable(ws, obstacles, p, x, d);
     let (s0, g0) = (cell_of(start), cell_of(goal));
     // A goal on the clearance's edge may round to a blocked cell: the nearest free cell within
     // two cells stands in for it (the path still ends at the goal itself).
@@ -282,6 +276,21 @@ pub fn plan_object_path(
         *last = goal;
     }
     Some(path)
+}
+
+/// Whether the robot can stand behind an object at `x` (its circle of `ws.object_radius`) to
+/// push it along `d`: always when `p.behind_penalty` is 1 (not checked).
+pub(crate) fn pushable(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    p: &ObstacleParams,
+    x: Vector2<f64>,
+    d: Vector2<f64>,
+) -> bool {
+    let behind = ws.object_radius + ws.robot_radius + p.room_margin;
+    p.behind_penalty <= 1
+        || d.try_normalize(1e-12)
+            .is_none_or(|u| robot_fits(ws, obstacles, x - u * behind))
 }
 
 /// Whether the robot's centre may stand at `p`: on the table and clear of every obstacle (by
@@ -407,11 +416,12 @@ pub fn scene_goal(scene: &Scene, object: Option<&str>) -> Result<Vector2<f64>> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use pushbot_world::workspace::Rect;
 
-    fn ws() -> Workspace {
+    /// A 1.4 × 1.0 m boundary on a 2.0 × 1.6 m table, a 4 cm robot, a 7 cm object.
+    pub(crate) fn ws() -> Workspace {
         Workspace {
             table: Rect {
                 min: [-0.2, -0.2],
@@ -427,7 +437,8 @@ mod tests {
         }
     }
 
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+    /// The rectangle from (x0, y0) to (x1, y1).
+    pub(crate) fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
         vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
     }
 
