@@ -9,7 +9,7 @@ use pushbot_world::workspace::Workspace;
 
 #[cfg(doc)]
 use crate::planner::global::plan_object_path;
-use crate::planner::global::{Clearances, ObstacleParams, clearance, pushable};
+use crate::planner::global::{Clearances, ObstacleParams, along, object_fits, pushable};
 
 /// A stretch of path at least this many times longer than the straight way between its ends
 /// is a detour ([`shortcut_object_path`]); a staircase of grid steps is at most 1.08 times.
@@ -35,12 +35,9 @@ pub fn shortcut_object_path(
     p: &ObstacleParams,
 ) -> Vec<Vector2<f64>> {
     let keep = Clearances::new(ws, p).object;
-    let fits = |x: Vector2<f64>| ws.boundary.contains(x) && clearance(x, obstacles) >= keep;
     let straight = |a: Vector2<f64>, b: Vector2<f64>| {
-        let n = ((b - a).norm() / 0.005).ceil().max(1.0) as usize;
-        (0..=n).all(|k| {
-            let x = a + (b - a) * (k as f64 / n as f64);
-            fits(x) && pushable(ws, obstacles, p, x, b - a)
+        along(a, b, |x| {
+            object_fits(ws, obstacles, keep, x) && pushable(ws, obstacles, p, x, b - a)
         })
     };
     let Some(&first) = path.first() else {
@@ -68,7 +65,7 @@ pub fn shortcut_object_path(
 mod tests {
     use super::*;
     use crate::planner::global::tests::{rect, ws};
-    use crate::planner::global::{path_length, plan_object_path, robot_fits};
+    use crate::planner::global::{clearance, path_length, plan_object_path, robot_fits};
 
     type Polygon = Vec<[f64; 2]>;
 

@@ -306,8 +306,28 @@ pub fn segment_clear(
     a: Vector2<f64>,
     b: Vector2<f64>,
 ) -> bool {
+    along(a, b, |x| robot_fits(ws, obstacles, x))
+}
+
+/// Whether `holds` at every point from `a` to `b`, both ends included, 5 mm apart or less.
+pub(crate) fn along(
+    a: Vector2<f64>,
+    b: Vector2<f64>,
+    holds: impl Fn(Vector2<f64>) -> bool,
+) -> bool {
     let n = ((b - a).norm() / 0.005).ceil().max(1.0) as usize;
-    (0..=n).all(|k| robot_fits(ws, obstacles, a + (b - a) * (k as f64 / n as f64)))
+    (0..=n).all(|k| holds(a + (b - a) * (k as f64 / n as f64)))
+}
+
+/// Whether the object's circle at `p` is inside the boundary and `keep` clear of every
+/// obstacle.
+pub(crate) fn object_fits(
+    ws: &Workspace,
+    obstacles: &[Vec<[f64; 2]>],
+    keep: f64,
+    p: Vector2<f64>,
+) -> bool {
+    ws.boundary.contains(p) && clearance(p, obstacles) >= keep
 }
 
 /// A path for the robot's centre from `start` to `goal` around `obstacles` (the same A* as the
@@ -357,10 +377,8 @@ pub fn shortest_object_path(
     };
     let path = plan_object_path(ws, obstacles, start, goal, &free)?;
     let keep = ws.object_radius + op.object_margin;
-    let fits = |p: Vector2<f64>| ws.boundary.contains(p) && clearance(p, obstacles) >= keep;
     Some(pull_taut(&path, |a, b| {
-        let n = ((b - a).norm() / 0.005).ceil().max(1.0) as usize;
-        (0..=n).all(|k| fits(a + (b - a) * (k as f64 / n as f64)))
+        along(a, b, |x| object_fits(ws, obstacles, keep, x))
     }))
 }
 
