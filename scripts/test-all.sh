@@ -41,6 +41,10 @@ cargo fmt --all -- --check
 say "lints"
 cargo clippy --workspace --all-targets -- -D warnings
 
+say "docs"
+# Every intra-doc link resolves and no public item's docs point at a private one.
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
+
 # The host stands on the world crate and the protocol; the simulator is only behind its default
 # feature `sim` (issue 18). Without it neither the simulator nor the firmware is in its tree, it
 # builds, and a command that would need the built-in target says so (exit 2).

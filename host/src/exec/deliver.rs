@@ -298,7 +298,7 @@ pub fn deliver_learned(
 /// ([`PathFollower::aim`]) rather than straight at the goal, the strategy is asked about that
 /// centre's motion ([`PushStrategy::about`]), and a stall is measured on the way left along the
 /// path. A special-case stand point whose push failed is not stood on again until a push goes
-/// the wanted way ([`Standing::failed`]).
+/// the wanted way (`Standing::failed`).
 pub fn deliver_learned_among(
     io: &mut dyn RobotIo,
     strategy: &mut PushStrategy,

@@ -33,7 +33,7 @@ use crate::planner::rearrange::problem::{Config, Dir, Model, Placement, Problem}
 pub struct ExecOptions {
     /// Side of a cell, m.
     pub cell: f64,
-    /// Fraction of its cells a movable's body fills (as in [`SceneOptions::fill`]).
+    /// Fraction of its cells a movable's body fills (as in [`crate::planner::rearrange::to_scene::SceneOptions::fill`]).
     pub fill: f64,
     /// Most segments before giving up.
     pub max_segments: usize,

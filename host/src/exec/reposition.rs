@@ -5,7 +5,7 @@
 //! the wanted direction turned or a single recorded push (a sample, §III-B) stood in for the
 //! regression. [`crate::exec::deliver::deliver_learned_among`] walks the robot there. On any
 //! table, a stand point the regression averaged into the object itself (pushes from both
-//! flanks of a thin or concave object) is moved back out along its push ([`stand_clear`]).
+//! flanks of a thin or concave object) is moved back out along its push (`stand_clear`).
 
 use nalgebra::Vector2;
 
@@ -35,7 +35,7 @@ pub(crate) struct Standing<'a> {
     /// Stand points that failed, object frame.
     pub failed: &'a [[f64; 2]],
     /// The object's outline in its marker's frame ([`crate::exec::io::RobotIo::object_outline`];
-    /// empty when not known): a stand point inside it is moved out ([`stand_clear`]).
+    /// empty when not known): a stand point inside it is moved out (`stand_clear`).
     pub outline: &'a [[f64; 2]],
 }
 

@@ -3,7 +3,7 @@
 //! (the plated differential-drive robot) driven as one `Velocity` arc per run of steps with
 //! one control.
 //!
-//! Plans may change contact ([`robot_problem_edges`]): between two pushing runs the robot
+//! Plans may change contact ([`crate::planner::stable::robot::robot_problem_edges`]): between two pushing runs the robot
 //! drives the plan's transit path ([`crate::planner::stable::transit`], §4.6's open problem) — straight back off
 //! the old edge, along the way points of the path for its turning disk, straight onto the new
 //! edge. Transits are closed loop between primitives: each leg is aimed from the observed robot
@@ -76,7 +76,7 @@ pub(crate) fn observe(io: &mut dyn RobotIo) -> Result<(Pose, Pose)> {
 
 /// Drive the plan open loop on `io` (the slider is the object `slider`): its pushing arcs, and
 /// at each contact change the plan's transit path ([`drive_transit`]). The robot starts flush
-/// on the first contact ([`robot_start`]). Observes only between primitives: to report drift
+/// on the first contact ([`crate::planner::stable::robot::robot_start`]). Observes only between primitives: to report drift
 /// and to drive transits. Returns each push and the slider's final pose.
 pub fn execute(p: &Problem, plan: &Plan, io: &mut dyn RobotIo) -> Result<(Vec<PushRecord>, Pose)> {
     let mut pushes = Vec::new();
@@ -157,7 +157,7 @@ pub(crate) fn flush_pose(p: &Problem, ci: usize, s: &Pose) -> (V2, V2) {
 }
 
 /// Turn the robot to face the world direction `h`: spins, measured between, until within
-/// [`HEADING_TOL`] (or out of tries).
+/// `HEADING_TOL` (or out of tries).
 fn face_dir(io: &mut dyn RobotIo, h: V2) -> Result<()> {
     face(io, h.y.atan2(h.x), &Turn::until(HEADING_TOL, TRIES))
 }
@@ -207,8 +207,8 @@ pub fn drive_transit(p: &Problem, tr: &TransitPath, io: &mut dyn RobotIo) -> Res
 }
 
 /// From a stand-off in front of contact `ci`'s edge, bring the plate flush onto it: onto the
-/// approach line (the axle's path straight in along the edge's normal) within [`LINE_TOL`],
-/// facing the edge within [`HEADING_TOL`], straight in to [`CREEP_GAP`] before the edge, face
+/// approach line (the axle's path straight in along the edge's normal) within `LINE_TOL`,
+/// facing the edge within `HEADING_TOL`, straight in to `CREEP_GAP` before the edge, face
 /// it again, and on at the pushing speed by the observed gap plus [`SEAT`], a short straight
 /// push that leaves the slider flush on the plate.
 pub fn approach(p: &Problem, ci: usize, io: &mut dyn RobotIo) -> Result<()> {

@@ -16,7 +16,7 @@ use crate::planner::stable::{Plan, Pose, Problem, plan as plan_stable};
 /// (no contact change, [`plan_inner`]); else starting on any pushing edge (the executor
 /// transits to it). The planner refuses a start where the slider (with the pusher) touches an
 /// obstacle, and a slider the closed loop let graze a wall is such a start: then the same from
-/// the nearest free pose within [`NUDGE`] (the closed loop takes up the difference).
+/// the nearest free pose within `NUDGE` (the closed loop takes up the difference).
 pub fn plan_from(p: &Problem, s: Pose, ci: usize) -> Option<Plan> {
     let kept = with_margin(p, MARGIN);
     let attempt = |q0: Pose| {
@@ -138,7 +138,7 @@ const NUDGE_TRIES: usize = 6;
 const NUDGE_CLEARANCE: f64 = 0.002;
 
 /// A plan for `p` that ends in the inner part of its goal neighbourhood where one exists
-/// ([`GOAL_SHRINK`]), exactly on the goal where the exact finish (§4.5) exists; `None` when no
+/// (`GOAL_SHRINK`), exactly on the goal where the exact finish (§4.5) exists; `None` when no
 /// plan reaches even the whole neighbourhood.
 pub fn plan_inner(p: &Problem) -> Option<Plan> {
     for shrink in GOAL_SHRINK {

@@ -1,6 +1,6 @@
 //! The global path of the object among obstacles, for delivery as Lau, Mitani & Igarashi
 //! describe it (§III-E, last paragraph): "we first compute a global collision-free path with
-//! existing planning techniques [LaValle], and then execute the robot to push the object along
+//! existing planning techniques \[LaValle\], and then execute the robot to push the object along
 //! sub-goals of this path". A pure planner: a function of the workspace, the obstacles and the
 //! goal; [`crate::exec::deliver_path`] pushes along it.
 //!

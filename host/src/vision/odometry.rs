@@ -79,7 +79,7 @@ impl OdometryLog {
     }
 
     /// The odometry pose at `time`, interpolated between the samples around it, or up to
-    /// [`EXTRAPOLATE`] past the newest at the rate of the last two; `None` otherwise.
+    /// `EXTRAPOLATE` past the newest at the rate of the last two; `None` otherwise.
     pub fn at(&self, time: f64) -> Option<Pose> {
         let i = self.samples.partition_point(|&(t, _)| t < time);
         if i == self.samples.len() {

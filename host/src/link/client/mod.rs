@@ -3,7 +3,7 @@
 //!
 //! CONTRACT (the drivers in [`super::serial`] and `crate::sim::inprocess` follow it):
 //!
-//! ```ignore
+//! ```text
 //! let mut client = Client::new(now, ClientOptions::default());
 //! let seq = client.hello(now);                       // or command(now, cmd), motion(…)
 //! loop {
@@ -17,7 +17,7 @@
 //!
 //! | what | where it lives |
 //! |---|---|
-//! | framing (`encode_frame`, `FrameDecoder`), rejected frames | here, through [`wire`]: the one place on the host that frames |
+//! | framing (`encode_frame`, `FrameDecoder`), rejected frames | here, through `wire`: the one place on the host that frames |
 //! | `Hello`, version check (also of a foreign `HelloReply`), sequence collisions | [`Client::hello`], [`Client::handshake`] |
 //! | sequence numbers, retries with the *same* number, giving up after `attempts` | [`Client::command`], [`Client::handle_timeout`], [`Client::take_answer`] |
 //! | replies matched by number: duplicates and late replies ignored, any order | [`Client::handle_bytes`] |

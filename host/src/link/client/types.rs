@@ -67,7 +67,7 @@ impl Default for ClientOptions {
     }
 }
 
-/// Something the client learned, in order, from [`Client::poll_event`].
+/// Something the client learned, in order, from [`super::Client::poll_event`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Event {
     /// Periodic state.

@@ -2,7 +2,7 @@
 //!
 //! A cost wave starts at the *set* of goal configurations (cost 0) and floods only admissible
 //! origins N_A⁻¹(Q), each relaxed by D(Q̂, Q), in the order of Dijkstra's algorithm. Costs are
-//! integers, so the wave front is a bucket (Dial) queue ([`super::wavefront`]): a ring of
+//! integers, so the wave front is a bucket (Dial) queue (`wavefront`): a ring of
 //! `max_edge + 1` buckets of packed indices. The map is one `u16` per packed configuration
 //! (`u16::MAX` = ∞, which also covers configurations in CCO and trap points: the backward wave
 //! never reaches them). A state is settled when it is swept with the cost it holds; stale

@@ -1,7 +1,7 @@
 //! Where the grid of a rearrangement problem lies on the table (Ben-Shahar & Rivlin §V-B): row
 //! 0 along the far edge, cell `(x, y)` centred at `((x + ½)·c, (h − y − ½)·c)` metres, table y
 //! pointing up. Shared by the scene rasterisation ([`super::scene`]) and the executor
-//! ([`super::execute`]), below both.
+//! ([`crate::exec::rearrange::execute`]), below both.
 
 use std::f64::consts::FRAC_PI_2;
 

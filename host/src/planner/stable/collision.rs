@@ -352,7 +352,7 @@ impl Cover {
 /// largest sagitta of the arcs between samples and a little more from the obstacles). Placed at
 /// a configuration `q` it contains everything the body touches during the step from `q`, so one
 /// static test replaces the sweep when it misses. When it does not, the same covers of
-/// [`SWEPT_PIECES`] pieces of the step (and the poses between them) are tried before the sweep.
+/// `SWEPT_PIECES` pieces of the step (and the poses between them) are tried before the sweep.
 #[derive(Clone)]
 pub struct Swept {
     whole: Cover,

@@ -154,7 +154,7 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
 }
 
 /// Plan with the given OPEN list and collision-check timing ([`Checks`]). A goal that
-/// [`unreachable`] proves cut off from the start is "no plan" without a search (no node
+/// [`fn@crate::planner::stable::reach::unreachable`] proves cut off from the start is "no plan" without a search (no node
 /// expanded; `unreachable(p)` gives the reason).
 pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();

@@ -127,7 +127,7 @@ pub const FINISH_DEPTH: f64 = 0.5;
 /// Where an exact finish of the step `xi` from `q` ends: from the first instant inside the goal
 /// neighbourhood ([`goal_crossing`]) on, the sampled instant deepest inside it (the largest
 /// margin to its faces, relative to their half-widths), if that is in the inner half
-/// ([`FINISH_DEPTH`]): a plan that ended on the neighbourhood's boundary would leave it at any
+/// (`FINISH_DEPTH`): a plan that ended on the neighbourhood's boundary would leave it at any
 /// execution error (the simulated robot's Fig. 13 ended 0.3° outside one).
 pub fn goal_finish(p: &Problem, q: &Pose, xi: &V3) -> Option<f64> {
     let t0 = goal_crossing(p, q, xi)?;

@@ -106,7 +106,7 @@ impl Leg {
 }
 
 /// What the transit paths of one problem share, computed once (a search asks for many): the
-/// turning disk's radius, each contact's [`Leg`], and the obstacles grown by the disk.
+/// turning disk's radius, each contact's `Leg`, and the obstacles grown by the disk.
 #[derive(Clone)]
 pub struct Transits {
     r: f64,
