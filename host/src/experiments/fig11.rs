@@ -165,6 +165,7 @@ mod tests {
             mean_robot_path_m: None,
             mean_path_ratio: None,
             max_path_ratio: None,
+            path_ratios: Vec::new(),
             failures: Default::default(),
             stall_recoveries: 0,
             silent_timeouts: 0,

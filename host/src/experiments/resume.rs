@@ -283,6 +283,7 @@ mod tests {
                 mean_robot_path_m: Some(1.25),
                 mean_path_ratio: None,
                 max_path_ratio: None,
+                path_ratios: Vec::new(),
                 failures: BTreeMap::from([("time-limit".to_owned(), 5 - successes)]),
                 stall_recoveries: 0,
                 silent_timeouts: 0,

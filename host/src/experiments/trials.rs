@@ -41,6 +41,10 @@ pub struct StartResult {
     pub mean_path_ratio: Option<f64>,
     /// Largest of those ratios.
     pub max_path_ratio: Option<f64>,
+    /// Each of those ratios, in trial order (a result written before they were kept has
+    /// none).
+    #[serde(default)]
+    pub path_ratios: Vec<f64>,
     /// Failures by reason.
     pub failures: BTreeMap<String, usize>,
     /// Stalls recovered from (or given up on) over all trials (deliveries among obstacles).
@@ -91,6 +95,7 @@ pub fn summarise(start: &str, method: Method, runs: &[Delivery]) -> StartResult 
         mean_robot_path_m: mean(ok.iter().map(|d| d.robot_path)),
         mean_path_ratio: mean(ratios.iter().copied()),
         max_path_ratio: ratios.iter().copied().reduce(f64::max),
+        path_ratios: ratios,
         failures,
         stall_recoveries: runs.iter().map(|d| d.recoveries.len()).sum(),
         silent_timeouts: runs
@@ -176,6 +181,29 @@ mod tests {
         assert_eq!(r.silent_timeouts, 1);
         assert_eq!(r.failures.get("time-limit"), Some(&2));
         assert_eq!(r.mean_path_ratio, Some(1.2));
+    }
+
+    /// Each successful trial's ratio is kept, in order; a failure's and one without a
+    /// shortest path are not, and the mean and the largest are of the kept ones.
+    #[test]
+    fn path_ratios_are_kept_per_successful_trial() {
+        let mut runs = [
+            run(None, 0),
+            run(Some(Failure::TimeLimit), 1),
+            run(None, 0),
+            run(None, 0),
+        ];
+        runs[2].body_path = 1.5;
+        runs[3].shortest_path = None;
+        let r = summarise("B", Method::Learned, &runs);
+        assert_eq!(r.path_ratios, [1.2, 1.5]);
+        assert_eq!(r.max_path_ratio, Some(1.5));
+        assert!((r.mean_path_ratio.unwrap() - 1.35).abs() < 1e-12);
+        // A result written before the ratios were kept still reads.
+        let mut v = serde_json::to_value(&r).unwrap();
+        v.as_object_mut().unwrap().remove("path_ratios");
+        let back: StartResult = serde_json::from_value(v).unwrap();
+        assert!(back.path_ratios.is_empty());
     }
 
     #[test]
