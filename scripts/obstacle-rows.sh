@@ -9,10 +9,10 @@
 #   scripts/obstacle-rows.sh OUT_DIR [TRIALS] [STRATEGY_SEEDS...]   (default: 20, seeds 1–5)
 #
 # A row in which a trial is not delivered exits 1 and is kept (the table counts it); any
-# other error stops the run. Each row's JSON is kept in OUT_DIR; the table (delivered, trials over 1.3× the shortest path,
-# the worst ratio, recoveries, time-outs without a recovery) is printed and written to
-# OUT_DIR/table.md. With 20 trials and five seeds (7200 deliveries) it takes about 13 minutes
-# on 2 cores. Rows already in OUT_DIR are not run again.
+# other error stops the run. Each row's JSON is kept in OUT_DIR; the table (delivered, trials
+# over 1.3× the shortest path, the worst ratio, recoveries, time-outs without a recovery) is
+# printed and written to OUT_DIR/table.md. With 20 trials and five seeds (7200 deliveries) it
+# takes about 8 minutes on 2 cores. Rows already in OUT_DIR are not run again.
 set -euo pipefail
 out=${1:?usage: obstacle-rows.sh OUT_DIR [TRIALS] [STRATEGY_SEEDS...]}
 trials=${2:-20}

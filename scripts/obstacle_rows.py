@@ -36,31 +36,31 @@ def main():
     out, seeds = sys.argv[1], sys.argv[2:]
     print("| strategy seed | delivered | over 1.3× | worst | recoveries | time-outs without a recovery |")
     print("|---|---|---|---|---|---|")
-    total = {"n": 0, "ok": 0, "over": 0, "worst": 0.0, "rec": 0, "silent": 0}
-    worst_where = ""
+    keys = ("trials", "successes", "over", "stall_recoveries", "silent_timeouts")
+    total = dict.fromkeys(keys, 0)
+    total_worst = (0.0, "")
     for s in seeds:
-        t = {"n": 0, "ok": 0, "over": 0, "worst": 0.0, "rec": 0, "silent": 0}
+        t = dict.fromkeys(keys, 0)
+        worst = (0.0, "")
         for name, r in rows(out, s):
-            t["n"] += r["trials"]
-            t["ok"] += r["successes"]
             ratios = r.get("path_ratios", [])
-            t["over"] += sum(1 for x in ratios if x > LIMIT)
-            if ratios and max(ratios) > t["worst"]:
-                t["worst"] = max(ratios)
-                if t["worst"] > total["worst"]:
-                    worst_where = f"{name} from {r['start']}"
-            t["rec"] += r["stall_recoveries"]
-            t["silent"] += r["silent_timeouts"]
-        print(f"| {s} | {t['ok']}/{t['n']} | {t['over']} | {t['worst']:.2f} | {t['rec']} | {t['silent']} |")
-        for k in ("n", "ok", "over", "rec", "silent"):
+            r = dict(r, over=sum(1 for x in ratios if x > LIMIT))
+            for k in keys:
+                t[k] += r[k]
+            worst = max([worst] + [(x, f"{name} from {r['start']}") for x in ratios])
+        print(
+            f"| {s} | {t['successes']}/{t['trials']} | {t['over']} | {worst[0]:.2f} | "
+            f"{t['stall_recoveries']} | {t['silent_timeouts']} |"
+        )
+        for k in keys:
             total[k] += t[k]
-        total["worst"] = max(total["worst"], t["worst"])
-    pct = 100.0 * total["ok"] / max(total["n"], 1)
+        total_worst = max(total_worst, worst)
+    pct = 100.0 * total["successes"] / max(total["trials"], 1)
     print(
-        f"| all | {total['ok']}/{total['n']} ({pct:.2f} %) | {total['over']} | "
-        f"{total['worst']:.2f} | {total['rec']} | {total['silent']} |"
+        f"| all | {total['successes']}/{total['trials']} ({pct:.2f} %) | {total['over']} | "
+        f"{total_worst[0]:.2f} | {total['stall_recoveries']} | {total['silent_timeouts']} |"
     )
-    print(f"\nworst: {worst_where}")
+    print(f"\nworst: {total_worst[1]}")
 
 
 if __name__ == "__main__":

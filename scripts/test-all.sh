@@ -74,6 +74,7 @@ if [ -n "$unshared" ]; then
   exit 1
 fi
 cargo clippy -p pushbot --no-default-features --lib --bins -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc -p pushbot --no-deps --no-default-features
 cargo build -p pushbot --no-default-features
 set +e
 msg=$(target/debug/pushbot robot info 2>&1)

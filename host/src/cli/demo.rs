@@ -11,7 +11,8 @@
 //!    them closed loop.
 //!
 //! It writes a report folder (`report.html`, `summary.json`, figures, `demo.log`) and prints its
-//! path. The pipeline is [`crate::experiments::demo`]; this module parses and prints.
+//! path. The pipeline is `crate::experiments::demo` (with the simulator); this module parses
+//! and prints.
 
 use std::path::PathBuf;
 #[cfg(feature = "sim")]

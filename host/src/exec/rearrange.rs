@@ -27,13 +27,15 @@ use crate::planner::rearrange::costmap::CostMap;
 use crate::planner::rearrange::frame::GridFrame;
 use crate::planner::rearrange::practical::Options;
 use crate::planner::rearrange::problem::{Config, Dir, Model, Placement, Problem};
+#[cfg(doc)]
+use crate::planner::rearrange::to_scene::SceneOptions;
 
 /// Settings of the executor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExecOptions {
     /// Side of a cell, m.
     pub cell: f64,
-    /// Fraction of its cells a movable's body fills (as in [`crate::planner::rearrange::to_scene::SceneOptions::fill`]).
+    /// Fraction of its cells a movable's body fills (as in [`SceneOptions::fill`]).
     pub fill: f64,
     /// Most segments before giving up.
     pub max_segments: usize,

@@ -3,7 +3,7 @@
 //! (the plated differential-drive robot) driven as one `Velocity` arc per run of steps with
 //! one control.
 //!
-//! Plans may change contact ([`crate::planner::stable::robot::robot_problem_edges`]): between two pushing runs the robot
+//! Plans may change contact ([`robot_problem_edges`]): between two pushing runs the robot
 //! drives the plan's transit path ([`crate::planner::stable::transit`], §4.6's open problem) — straight back off
 //! the old edge, along the way points of the path for its turning disk, straight onto the new
 //! edge. Transits are closed loop between primitives: each leg is aimed from the observed robot
@@ -19,6 +19,8 @@ use crate::exec::io::RobotIo;
 use crate::exec::maneuver::{Drive, Turn, face, go_to};
 use crate::mechanics::{V2, cross};
 use crate::planner::stable::robot::{SPEED, arcs, robot_in_slider};
+#[cfg(doc)]
+use crate::planner::stable::robot::{robot_problem_edges, robot_start};
 use crate::planner::stable::transit::TransitPath;
 use crate::planner::stable::{Plan, Pose, Problem, angle_diff};
 
@@ -76,7 +78,7 @@ pub(crate) fn observe(io: &mut dyn RobotIo) -> Result<(Pose, Pose)> {
 
 /// Drive the plan open loop on `io` (the slider is the object `slider`): its pushing arcs, and
 /// at each contact change the plan's transit path ([`drive_transit`]). The robot starts flush
-/// on the first contact ([`crate::planner::stable::robot::robot_start`]). Observes only between primitives: to report drift
+/// on the first contact ([`robot_start`]). Observes only between primitives: to report drift
 /// and to drive transits. Returns each push and the slider's final pose.
 pub fn execute(p: &Problem, plan: &Plan, io: &mut dyn RobotIo) -> Result<(Vec<PushRecord>, Pose)> {
     let mut pushes = Vec::new();

@@ -16,7 +16,8 @@
 //! - [`tracking`]: a Kalman filter per body;
 //! - [`Pipeline`]: detect → measure → filter per frame; between whole-frame searches it looks
 //!   only in regions around each tracked marker's predicted place ([`RoiParams`]);
-//! - [`crate::sim::synth`] and [`mod@bench`]: rendered test frames with ground truth, and `pushbot bench vision`.
+//! - `crate::sim::synth` and `bench` (with the simulator): rendered test frames with ground
+//!   truth, and `pushbot bench vision`.
 //!
 //! The choice, measured by `pushbot bench vision` on the same rendered 960×720 frames: the C
 //! detector at `quad_sigma = 1` (as fast as kornia-apriltag at its defaults on whole frames,

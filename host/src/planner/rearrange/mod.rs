@@ -11,7 +11,7 @@
 //! - [`budget`]: the memory the exact map needs, known before it is built (§IV-E);
 //! - [`practical`]: the practical mode for many movables, an object-level search over exact
 //!   single-object legs;
-//! - [`mod@restore`]: the pushing C-path restoration phase, §IV-A2;
+//! - [`restore`](mod@restore): the pushing C-path restoration phase, §IV-A2;
 //! - [`cases`]: the test cases A–D of §V-A (scene presets) and reading scenes;
 //! - [`scene`]: the shared scene format (`[rearrange]` section) rasterised to a grid problem;
 //! - [`svg`]: plans drawn as the paper's step-by-step figures;

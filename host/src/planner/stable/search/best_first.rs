@@ -154,8 +154,8 @@ pub fn plan_with(p: &Problem, queue: Queue) -> Plan {
 }
 
 /// Plan with the given OPEN list and collision-check timing ([`Checks`]). A goal that
-/// [`fn@crate::planner::stable::reach::unreachable`] proves cut off from the start is "no plan" without a search (no node
-/// expanded; `unreachable(p)` gives the reason).
+/// [`unreachable`](fn@unreachable) proves cut off from the start is "no plan" without a search (no
+/// node expanded; `unreachable(p)` gives the reason).
 pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
     let t0 = Instant::now();
     if unreachable(p).is_some() {
