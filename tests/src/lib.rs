@@ -24,14 +24,16 @@ pub fn sim_at(seed: u64, x: f64, y: f64, theta: f64) -> PtySim {
 }
 
 /// Connect the host link to the simulated robot, through its pty path like to hardware, with
-/// the robot's link watchdog at 1 s of robot time (200 ms of wall time at [`SIM_SPEED`]): these
-/// tests share two cores with builds, and a test of motion must not fail because the host's
-/// reader thread waited 40 ms for a core. The watchdog's own tests use [`connect_strict`].
+/// the robot's link watchdog at the longest the firmware takes, 5 s of robot time (1 s of wall
+/// time at [`SIM_SPEED`]): these tests share two cores with builds and with each other, and a
+/// test of motion must not fail because the host's threads waited for a core. At 1 s of robot
+/// time (200 ms of wall time) it did, once in many runs: a square's third leg ended on the
+/// watchdog while the tests ran two at a time. The watchdog's own tests use [`connect_strict`].
 pub fn connect(sim: &PtySim) -> Robot {
     let robot = connect_strict(sim);
     robot
         .configure(pushbot_protocol::ConfigUpdate {
-            watchdog_ms: Some(1000),
+            watchdog_ms: Some(pushbot_firmware::RobotParams::default().max_watchdog_ms),
             ..Default::default()
         })
         .expect("configure the link watchdog");
