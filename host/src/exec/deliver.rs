@@ -408,6 +408,14 @@ pub fn deliver_learned_among(
             step
         };
         let keyed: &PushStrategy = about_body.as_ref().unwrap_or(strategy);
+        // On the last leg the general case pushes only from where the samples have pushed
+        // the object the wanted way; from elsewhere the special case stands the robot there.
+        if !special && last_leg && p.last_leg_trust > 0.0 {
+            let pl = o.point_to_local(r.position());
+            special = keyed
+                .general_distance([pl.x, pl.y], want)
+                .is_some_and(|d| d > p.last_leg_trust);
+        }
         let mut stood = None;
         let dir_world = if special {
             let circle = circle_of(&o);

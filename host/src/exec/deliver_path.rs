@@ -5,7 +5,9 @@
 //! ([`crate::planner::path_follow`]), until it reaches the goal within the success radius.
 //! Near a wall a push that drifted the object towards it is not continued: the robot cannot
 //! stand between the wall and the object to push it back, so the special case re-positions at
-//! once ([`crate::exec::drift`]).
+//! once ([`crate::exec::drift`]). On the last leg, where the marker is pushed to the goal past
+//! the path's sub-goals, a general-case push is made only from where the samples have pushed
+//! the object the wanted way ([`ObstacleParams::last_leg_trust`]).
 //!
 //! A leg that makes no progress along its path for `stall_time` (the object caught on a
 //! corner) is a **stall**, never a silent time-out: the robot backs off the object, the path is
@@ -90,6 +92,7 @@ pub fn deliver_among_obstacles(
         let leg_params = DeliveryParams {
             time_limit: left,
             stall_time: op.stall_time,
+            last_leg_trust: op.last_leg_trust,
             reposition_angle: op.reposition_angle,
             wall_near: op.wall_near,
             wall_reposition_angle: op.wall_reposition_angle,

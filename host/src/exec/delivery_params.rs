@@ -4,6 +4,8 @@
 //! is made of ([`crate::exec::drift`], [`crate::exec::stall`]).
 
 use crate::strategy::dipole::DipoleParams;
+#[cfg(doc)]
+use crate::strategy::regression::PushStrategy;
 
 /// Parameters of delivery.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,6 +50,12 @@ pub struct DeliveryParams {
     pub stall_time: f64,
     /// Progress towards the goal that counts against a stall, m.
     pub stall_progress: f64,
+    /// Along a path, on its last leg (the marker pushed to the goal): the general case pushes
+    /// only when a sample lies within this of its query in (p, s)
+    /// ([`PushStrategy::general_distance`]), m; farther, the special case stands the robot where
+    /// the samples show that push. 0: off (the paper, and a clear table). Set by deliveries
+    /// among obstacles ([`crate::planner::global::ObstacleParams::last_leg_trust`]).
+    pub last_leg_trust: f64,
     /// Dipole baseline: length of one drive step, s.
     pub dipole_step: f64,
     /// Dipole baseline: controller parameters.
@@ -72,6 +80,7 @@ impl Default for DeliveryParams {
             wall_reposition_angle: std::f64::consts::FRAC_PI_2,
             stall_time: 0.0,
             stall_progress: 0.02,
+            last_leg_trust: 0.0,
             dipole_step: 0.25,
             dipole: DipoleParams::default(),
         }

@@ -299,6 +299,20 @@ impl PushStrategy {
         Some([r[0] / total, r[1] / total])
     }
 
+    /// How far the general case's nearest sample is from its query ([`Self::general`]: the
+    /// robot at `p`, the object wanted along `goal_dir`), m in (p_x, p_y, s_x, s_y): how much
+    /// the strategy has seen of pushing from there that way. `None` without samples or for a
+    /// non-finite query.
+    pub fn general_distance(&self, p: [f64; 2], goal_dir: [f64; 2]) -> Option<f64> {
+        let off = self.offset();
+        let q = [p[0], p[1], off * goal_dir[0], off * goal_dir[1]];
+        if q.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let near = self.nearest(self.general.as_ref(), &general_key, &q);
+        near.first().map(|n| n.0.sqrt())
+    }
+
     /// Special case: where to stand and how to push so the object moves along `goal_dir`.
     pub fn special(&self, goal_dir: [f64; 2]) -> Option<Reposition> {
         let off = self.offset();
@@ -402,6 +416,36 @@ mod tests {
                 "{got:?} vs {want:?}"
             );
         }
+    }
+
+    /// The general case's nearest-sample distance is the brute-force one, over indexed and
+    /// recent samples, and 0 at a sample's own key.
+    #[test]
+    fn general_distance_is_the_nearest_samples_distance() {
+        let samples = random_samples(1000, 11);
+        let mut strat = PushStrategy::new(samples[..900].iter().copied(), KernelParams::default());
+        for s in &samples[900..] {
+            strat.add(*s);
+        }
+        let off = strat.offset();
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        for _ in 0..200 {
+            let p = [rng.random_range(-0.2..0.2), rng.random_range(-0.2..0.2)];
+            let a: f64 = rng.random_range(-3.2..3.2);
+            let q = [p[0], p[1], off * a.cos(), off * a.sin()];
+            let want = samples
+                .iter()
+                .map(|s| dist2(&general_key(s), &q).sqrt())
+                .fold(f64::INFINITY, f64::min);
+            let got = strat.general_distance(p, [a.cos(), a.sin()]).unwrap();
+            assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+        }
+        let s = samples[950];
+        let dir = [s.s[0] / off, s.s[1] / off];
+        assert!(strat.general_distance(s.p, dir).unwrap() < 1e-12);
+        let empty = PushStrategy::new([], KernelParams::default());
+        assert_eq!(empty.general_distance([0.0, 0.0], [1.0, 0.0]), None);
+        assert_eq!(strat.general_distance([f64::NAN, 0.0], [1.0, 0.0]), None);
     }
 
     #[test]
