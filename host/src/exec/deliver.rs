@@ -410,8 +410,8 @@ pub fn deliver_learned_among(
         let keyed: &PushStrategy = about_body.as_ref().unwrap_or(strategy);
         // On the last leg the general case pushes only from where the samples have pushed
         // the object the wanted way; from elsewhere the special case stands the robot there.
+        let pl = o.point_to_local(r.position());
         if !special && last_leg && p.last_leg_trust > 0.0 {
-            let pl = o.point_to_local(r.position());
             special = keyed
                 .general_distance([pl.x, pl.y], want)
                 .is_some_and(|d| d > p.last_leg_trust);
@@ -469,7 +469,6 @@ pub fn deliver_learned_among(
             go_to(io, at, &Drive::two_level(p.heading_tolerance))?;
             o.vector_to_world(Vector2::new(rep.r[0], rep.r[1]))
         } else {
-            let pl = o.point_to_local(r.position());
             let Some(rr) = keyed.general([pl.x, pl.y], want) else {
                 return Ok(finish(
                     io,

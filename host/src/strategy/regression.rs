@@ -281,11 +281,7 @@ impl PushStrategy {
     /// The general case at a raw key: the kernel-weighted robot motion of the k samples nearest
     /// to (p, s), object frame. `None` without samples or for a non-finite query.
     pub fn predict(&self, p: [f64; 2], s: [f64; 2]) -> Option<[f64; 2]> {
-        let q = [p[0], p[1], s[0], s[1]];
-        if q.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        let near = self.nearest(self.general.as_ref(), &general_key, &q);
+        let near = self.general_near(p, s)?;
         let w = self.weights(&near);
         let total: f64 = w.iter().sum();
         if near.is_empty() || total <= 0.0 {
@@ -305,12 +301,18 @@ impl PushStrategy {
     /// non-finite query.
     pub fn general_distance(&self, p: [f64; 2], goal_dir: [f64; 2]) -> Option<f64> {
         let off = self.offset();
-        let q = [p[0], p[1], off * goal_dir[0], off * goal_dir[1]];
+        let near = self.general_near(p, [off * goal_dir[0], off * goal_dir[1]])?;
+        near.first().map(|n| n.0.sqrt())
+    }
+
+    /// The general case's k nearest samples to (p, s) ([`Self::nearest`]); `None` for a
+    /// non-finite query.
+    fn general_near(&self, p: [f64; 2], s: [f64; 2]) -> Option<Vec<(f64, usize)>> {
+        let q = [p[0], p[1], s[0], s[1]];
         if q.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        let near = self.nearest(self.general.as_ref(), &general_key, &q);
-        near.first().map(|n| n.0.sqrt())
+        Some(self.nearest(self.general.as_ref(), &general_key, &q))
     }
 
     /// Special case: where to stand and how to push so the object moves along `goal_dir`.
