@@ -7,7 +7,9 @@
 //! stand between the wall and the object to push it back, so the special case re-positions at
 //! once ([`crate::exec::drift`]). On the last leg, where the marker is pushed to the goal past
 //! the path's sub-goals, a general-case push is made only from where the samples have pushed
-//! the object the wanted way ([`ObstacleParams::last_leg_trust`]).
+//! the object the wanted way ([`ObstacleParams::last_leg_trust`]), and where the goal is too
+//! near a wall for the robot to stand between them, the marker is aimed a little away from the
+//! wall, inside the success radius ([`ObstacleParams::goal_wall_offset`]).
 //!
 //! A leg that makes no progress along its path for `stall_time` (the object caught on a
 //! corner) is a **stall**, never a silent time-out: the robot backs off the object, the path is
@@ -93,6 +95,7 @@ pub fn deliver_among_obstacles(
             time_limit: left,
             stall_time: op.stall_time,
             last_leg_trust: op.last_leg_trust,
+            goal_wall_offset: op.goal_wall_offset,
             reposition_angle: op.reposition_angle,
             wall_near: op.wall_near,
             wall_reposition_angle: op.wall_reposition_angle,

@@ -56,6 +56,16 @@ pub struct DeliveryParams {
     /// the samples show that push. 0: off (the paper, and a clear table). Set by deliveries
     /// among obstacles ([`crate::planner::global::ObstacleParams::last_leg_trust`]).
     pub last_leg_trust: f64,
+    /// Along a path, on its last leg: where the robot cannot stand between the object at the
+    /// goal and the nearest obstacle (the goal nearer to it than the object's enclosing circle,
+    /// the robot's width and [`Self::bound_all_margin`]), the marker is aimed this far from the
+    /// goal away from the obstacle, m (at most [`Self::success_radius`]; success is still
+    /// measured at the goal). A push that ends short towards the wall then still delivers, and
+    /// one that ends short away from it leaves the robot room to correct it; aimed at the goal,
+    /// the object stalled beside it against the wall. 0: off (the paper, and a clear table).
+    /// Set by deliveries among obstacles
+    /// ([`crate::planner::global::ObstacleParams::goal_wall_offset`]).
+    pub goal_wall_offset: f64,
     /// Dipole baseline: length of one drive step, s.
     pub dipole_step: f64,
     /// Dipole baseline: controller parameters.
@@ -81,6 +91,7 @@ impl Default for DeliveryParams {
             stall_time: 0.0,
             stall_progress: 0.02,
             last_leg_trust: 0.0,
+            goal_wall_offset: 0.0,
             dipole_step: 0.25,
             dipole: DipoleParams::default(),
         }

@@ -65,10 +65,12 @@ pub struct ObstacleParams {
     /// On the last leg, the general case's trust radius, m
     /// ([`crate::exec::deliver::DeliveryParams::last_leg_trust`]). Near the goal a general-case
     /// push from where no sample pushed that way (the robot beside the object after the last
-    /// sub-goal) sent the L-shape sideways and back; over its 3600 obstacle trials 2 cm gave 6
-    /// over 1.3× the shortest path against 8 (mean ratio 1.074 against 1.075). On every leg it
-    /// gave the straightest paths (mean 1.063) but stalled more (75 recoveries against 43).
+    /// sub-goal) sent the L-shape sideways and back (`results/obstacle-rows/README.md`).
     pub last_leg_trust: f64,
+    /// On the last leg, where the robot has no room between the object at the goal and a wall,
+    /// the marker is aimed this far from the goal away from the wall, m
+    /// ([`crate::exec::deliver::DeliveryParams::goal_wall_offset`]).
+    pub goal_wall_offset: f64,
     /// A leg stalls when the object comes no closer to its sub-goal for this long, s.
     pub stall_time: f64,
     /// Recoveries tried before a delivery is given up as stalled.
@@ -90,6 +92,7 @@ impl Default for ObstacleParams {
             wall_near: 0.07,
             wall_reposition_angle: 10f64.to_radians(),
             last_leg_trust: 0.02,
+            goal_wall_offset: 0.011,
             stall_time: 60.0,
             max_recoveries: 4,
         }
@@ -98,12 +101,18 @@ impl Default for ObstacleParams {
 
 /// Distance from `p` to the polygon `poly` (0 inside it).
 pub fn polygon_distance(p: Vector2<f64>, poly: &[[f64; 2]]) -> f64 {
+    polygon_nearest(p, poly).map_or(f64::INFINITY, |(d, _)| d)
+}
+
+/// Distance from `p` to the polygon `poly` and the polygon's point nearest to it (`p` itself,
+/// at distance 0, inside it); `None` for an empty polygon.
+fn polygon_nearest(p: Vector2<f64>, poly: &[[f64; 2]]) -> Option<(f64, Vector2<f64>)> {
     let n = poly.len();
     if n == 0 {
-        return f64::INFINITY;
+        return None;
     }
     let mut inside = false;
-    let mut best = f64::INFINITY;
+    let mut best = (f64::INFINITY, p);
     for i in 0..n {
         let a = Vector2::new(poly[i][0], poly[i][1]);
         let b = Vector2::new(poly[(i + 1) % n][0], poly[(i + 1) % n][1]);
@@ -116,9 +125,25 @@ pub fn polygon_distance(p: Vector2<f64>, poly: &[[f64; 2]]) -> f64 {
         } else {
             0.0
         };
-        best = best.min((a + t * ab - p).norm());
+        let q = a + t * ab;
+        if (q - p).norm() < best.0 {
+            best = ((q - p).norm(), q);
+        }
     }
-    if inside { 0.0 } else { best }
+    Some(if inside { (0.0, p) } else { best })
+}
+
+/// The clearance of `p` ([`clearance`]) and the unit direction away from the nearest
+/// obstacle's nearest point; `None` without obstacles, or with `p` on or inside one.
+pub fn away_from_obstacles(
+    p: Vector2<f64>,
+    obstacles: &[Vec<[f64; 2]>],
+) -> Option<(f64, Vector2<f64>)> {
+    let (d, q) = obstacles
+        .iter()
+        .filter_map(|o| polygon_nearest(p, o))
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    Some((d, (p - q).try_normalize(1e-12)?))
 }
 
 /// Distance from `p` to the nearest obstacle.
@@ -474,6 +499,18 @@ pub(crate) mod tests {
         assert_eq!(polygon_distance(Vector2::new(0.5, 0.5), &r), 0.0);
         assert!((polygon_distance(Vector2::new(2.0, 0.5), &r) - 1.0).abs() < 1e-12);
         assert!((polygon_distance(Vector2::new(2.0, 2.0), &r) - 2f64.sqrt()).abs() < 1e-12);
+        // Away from the nearer of two: off a face square to it, off a corner along the diagonal.
+        let two = [r.clone(), rect(3.0, 0.0, 4.0, 1.0)];
+        let away = |x: f64, y: f64| away_from_obstacles(Vector2::new(x, y), &two);
+        let (d, u) = away(1.4, 0.5).unwrap();
+        assert!((d - 0.4).abs() < 1e-12 && (u - Vector2::x()).norm() < 1e-12);
+        let (d, u) = away(2.7, 0.5).unwrap();
+        assert!((d - 0.3).abs() < 1e-12 && (u + Vector2::x()).norm() < 1e-12);
+        let (d, u) = away(1.8, 2.0).unwrap();
+        let diag = Vector2::new(0.8f64, 1.0);
+        assert!((d - diag.norm()).abs() < 1e-12 && (u - diag.normalize()).norm() < 1e-12);
+        assert_eq!(d, clearance(Vector2::new(1.8, 2.0), &two));
+        assert!(away(0.5, 0.5).is_none() && away_from_obstacles(Vector2::zeros(), &[]).is_none());
     }
 
     #[test]
