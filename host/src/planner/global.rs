@@ -126,8 +126,9 @@ fn polygon_nearest(p: Vector2<f64>, poly: &[[f64; 2]]) -> Option<(f64, Vector2<f
             0.0
         };
         let q = a + t * ab;
-        if (q - p).norm() < best.0 {
-            best = ((q - p).norm(), q);
+        let d = (q - p).norm();
+        if d < best.0 {
+            best = (d, q);
         }
     }
     Some(if inside { (0.0, p) } else { best })
