@@ -28,7 +28,7 @@ use crate::exec::stall::StallWatch;
 use crate::planner::global::away_from_obstacles;
 use crate::planner::path_follow::PathFollower;
 use crate::strategy::dipole::{self, DipoleCommand};
-use crate::strategy::regression::PushStrategy;
+use crate::strategy::regression::{KernelParams, PushStrategy};
 use crate::strategy::sample::{Pose2, Sample, wrap_angle};
 
 /// Why a delivery failed.
@@ -334,6 +334,9 @@ pub fn deliver_learned_among(
     // a clear table.
     let body = ws.body.centre;
     let mut about_body = (path.is_some() && body != [0.0, 0.0]).then(|| strategy.about(body));
+    // On the last leg, the same samples with the special case's heavier turn weight
+    // ([`DeliveryParams::last_leg_turn_weight`]).
+    let mut last_keyed: Option<PushStrategy> = None;
     // Among obstacles, the special case's stand points (object frame) whose push failed since
     // the last push that went the wanted way: not tried again while another is reachable.
     let mut failed: Vec<[f64; 2]> = Vec::new();
@@ -363,6 +366,7 @@ pub fn deliver_learned_among(
                     if !last_leg {
                         last_leg = true;
                         stall = StallWatch::new(p, io.time());
+                        last_keyed = last_leg_strategy(strategy, body, p);
                     }
                     (false, goal_aim, (goal_aim - o.position()).norm())
                 }
@@ -409,7 +413,10 @@ pub fn deliver_learned_among(
         } else {
             step
         };
-        let keyed: &PushStrategy = about_body.as_ref().unwrap_or(strategy);
+        let keyed: &PushStrategy = last_keyed
+            .as_ref()
+            .or(about_body.as_ref())
+            .unwrap_or(strategy);
         // On the last leg the general case pushes only from where the samples have pushed
         // the object the wanted way; from elsewhere the special case stands the robot there.
         let pl = o.point_to_local(r.position());
@@ -506,6 +513,9 @@ pub fn deliver_learned_among(
         // admission rule: a collection's selective sampling).
         if moved.norm() >= p.moved_epsilon && strategy.offer(sample) {
             sink(&sample)?;
+            if let Some(b) = last_keyed.as_mut() {
+                b.add(sample.about(body));
+            }
             if let Some(b) = about_body.as_mut() {
                 b.add(sample.about(body));
             }
@@ -525,6 +535,23 @@ pub fn deliver_learned_among(
             failed.push(at);
         }
     }
+}
+
+/// The strategy the last leg asks when [`DeliveryParams::last_leg_turn_weight`] is set: the
+/// samples keyed on the body's centre `body` with that turn weight; `None` when it is not set.
+fn last_leg_strategy(
+    strategy: &PushStrategy,
+    body: [f64; 2],
+    p: &DeliveryParams,
+) -> Option<PushStrategy> {
+    (p.last_leg_turn_weight > 0.0).then(|| {
+        let mut k = strategy.about(body);
+        k.set_params(KernelParams {
+            turn_weight: p.last_leg_turn_weight,
+            ..k.params()
+        });
+        k
+    })
 }
 
 /// Where the last leg along a path aims the marker: `goal`, or where the robot has no room
@@ -605,6 +632,34 @@ mod tests {
         };
         let aim = last_leg_aim(&ws, &wall, goal, &far);
         assert!(((aim - goal).norm() - far.success_radius).abs() < 1e-12);
+    }
+
+    /// The last leg's strategy: none unless its turn weight is set; with it, the same samples
+    /// keyed on the body's centre, and only the turn weight changed.
+    #[test]
+    fn the_last_leg_asks_the_body_keyed_samples_with_its_turn_weight() {
+        let s = Sample {
+            p: [-0.08, 0.0],
+            r: [0.04, 0.0],
+            s: [0.03, 0.01],
+            theta: 0.2,
+        };
+        let strategy = PushStrategy::new([s], KernelParams::default());
+        let body = [0.04, 0.035];
+        assert!(last_leg_strategy(&strategy, body, &DeliveryParams::default()).is_none());
+        let p = DeliveryParams {
+            last_leg_turn_weight: 0.06,
+            ..DeliveryParams::default()
+        };
+        let k = last_leg_strategy(&strategy, body, &p).unwrap();
+        assert_eq!(
+            k.params(),
+            KernelParams {
+                turn_weight: 0.06,
+                ..strategy.params()
+            }
+        );
+        assert_eq!(k.samples(), strategy.about(body).samples());
     }
 
     /// A body that moves 1 m in 4 cm pushes, looked at 6 times between pushes (as the special

@@ -96,6 +96,7 @@ pub fn deliver_among_obstacles(
             stall_time: op.stall_time,
             last_leg_trust: op.last_leg_trust,
             goal_wall_offset: op.goal_wall_offset,
+            last_leg_turn_weight: op.last_leg_turn_weight,
             reposition_angle: op.reposition_angle,
             wall_near: op.wall_near,
             wall_reposition_angle: op.wall_reposition_angle,

@@ -66,6 +66,12 @@ pub struct DeliveryParams {
     /// Set by deliveries among obstacles
     /// ([`crate::planner::global::ObstacleParams::goal_wall_offset`]).
     pub goal_wall_offset: f64,
+    /// Along a path, on its last leg: the special case's turn weight
+    /// ([`crate::strategy::regression::KernelParams::turn_weight`]), m a radian; 0 keeps the
+    /// strategy's. Near the goal a stand point whose push turned the L-shape about its marker
+    /// swung its body back and forth beside the goal. Set by deliveries among obstacles
+    /// ([`crate::planner::global::ObstacleParams::last_leg_turn_weight`]).
+    pub last_leg_turn_weight: f64,
     /// Dipole baseline: length of one drive step, s.
     pub dipole_step: f64,
     /// Dipole baseline: controller parameters.
@@ -92,6 +98,7 @@ impl Default for DeliveryParams {
             stall_progress: 0.02,
             last_leg_trust: 0.0,
             goal_wall_offset: 0.0,
+            last_leg_turn_weight: 0.0,
             dipole_step: 0.25,
             dipole: DipoleParams::default(),
         }

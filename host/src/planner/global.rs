@@ -71,6 +71,9 @@ pub struct ObstacleParams {
     /// the marker is aimed this far from the goal away from the wall, m
     /// ([`crate::exec::deliver::DeliveryParams::goal_wall_offset`]).
     pub goal_wall_offset: f64,
+    /// On the last leg, the special case's turn weight, m a radian
+    /// ([`crate::exec::deliver::DeliveryParams::last_leg_turn_weight`]).
+    pub last_leg_turn_weight: f64,
     /// A leg stalls when the object comes no closer to its sub-goal for this long, s.
     pub stall_time: f64,
     /// Recoveries tried before a delivery is given up as stalled.
@@ -93,6 +96,7 @@ impl Default for ObstacleParams {
             wall_reposition_angle: 10f64.to_radians(),
             last_leg_trust: 0.02,
             goal_wall_offset: 0.011,
+            last_leg_turn_weight: 0.06,
             stall_time: 60.0,
             max_recoveries: 4,
         }
