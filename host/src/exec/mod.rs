@@ -5,7 +5,8 @@
 //!
 //! - [`collect`]: Lau et al.'s Algorithm 1 (collecting the pushing strategy);
 //! - [`deliver`]: Algorithm 2 (learned delivery) and the dipole-field baseline;
-//! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals;
+//! - [`deliver_path`]: delivery among obstacles along the global path's sub-goals, and
+//!   [`last_leg`] its last stretch to the goal;
 //! - [`rearrange`]: Ben-Shahar & Rivlin's plans driven with re-observation and snapping;
 //! - [`stable`]: Lynch & Mason's stable pushes on the plated robot, with transits;
 //! - [`stable_feedback`]: the same plans driven closed loop: steering inside the stable set,
@@ -24,6 +25,7 @@ pub mod drift;
 pub mod grabber;
 pub mod grid_snap;
 pub mod io;
+pub mod last_leg;
 pub mod live;
 pub mod maneuver;
 pub mod occlusion;
