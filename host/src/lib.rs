@@ -17,4 +17,5 @@ pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod strategy;
+pub mod task;
 pub mod vision;

@@ -18,6 +18,7 @@ pub mod link_bench;
 pub mod rearrange;
 pub mod replay;
 pub mod robot;
+pub mod run;
 pub mod scene;
 pub mod stable;
 pub mod stable_run;
@@ -112,13 +113,14 @@ pub enum Command {
     /// Plan a task without running it.
     #[command(subcommand)]
     Plan(PlanCommand),
-    /// Collect a pushing strategy for an object (Lau et al. Algorithm 1), in simulation.
+    /// Collect a pushing strategy for an object (Lau et al. Algorithm 1): on the robot with
+    /// --port/--camera, else in simulation.
     Collect(strategy_args::CollectArgs),
     /// Evaluate: `eval delivery` (Lau et al. Fig. 11, learned vs dipole).
     Eval(strategy_args::EvalArgs),
     /// Run one task on the robot (simulated or real).
     #[command(subcommand)]
-    Run(stable_run::RunCommand),
+    Run(run::RunCommand),
     /// Calibrate the overhead camera from markers at known table positions; `calibrate lens`
     /// finds the lens's intrinsics and distortion from frames of a printed board
     /// (`calibrate board` writes it).
@@ -281,11 +283,19 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ),
     (
         "run",
-        "pushbot run stable --scene fig15 --perturb --trial 3",
+        "pushbot run deliver --object irregular --goal 1.0,0.6",
+    ),
+    (
+        "run deliver",
+        "pushbot run deliver --object irregular --goal 1.0,0.6 --port /dev/ttyACM0 --camera /dev/video0",
+    ),
+    (
+        "run rearrange",
+        "pushbot run rearrange --scene A1 --goal box1=0.35,0.45 --mode exact",
     ),
     (
         "run stable",
-        "pushbot run stable --scene fig15 --perturb --trial 3 --hil",
+        "pushbot run stable --scene fig15 --goal 0.6,0.5,90",
     ),
     ("scene", "pushbot scene check --scene my-table.toml"),
     (
@@ -418,7 +428,7 @@ pub fn run(cli: Cli) -> CliResult {
             cmd: strategy_args::EvalCmd::Stable(a),
         }) => stable_run::eval(&global, &a),
         Command::Eval(args) => strategy::run_eval(&global, args),
-        Command::Run(cmd) => stable_run::run(&global, cmd),
+        Command::Run(cmd) => run::run(&global, cmd),
         Command::Scene(cmd) => scene::run(&global, cmd),
     }
 }

@@ -1,4 +1,4 @@
-//! `pushbot run stable` and `pushbot eval stable`: Lynch & Mason's stable pushes (§4) planned
+//! `pushbot eval stable`: Lynch & Mason's stable pushes (§4) planned
 //! for the plated robot and driven closed loop (issue 21; [`crate::exec::stable_feedback`]) —
 //! or open loop, as the paper drives them, with `--open-loop` — on the in-process simulated
 //! robot, perturbed with `--perturb` (the scene's `[perturb]` ranges, seeded by `--seed` and
@@ -7,16 +7,9 @@
 //! N` runs the random scenes of `planner::stable::random_scene` (diff-drive or car) instead of
 //! one scene.
 
-use clap::{Args, Subcommand};
+use clap::Args;
 
 use super::{CliError, CliResult, Global};
-
-/// `pushbot run`: one task on the robot.
-#[derive(Subcommand, Debug)]
-pub enum RunCommand {
-    /// Plan stable pushes for the plated robot and drive them closed loop, once.
-    Stable(StableRunArgs),
-}
 
 /// The arguments `run stable` and `eval stable` share.
 #[derive(Args, Debug, Clone)]
@@ -119,18 +112,6 @@ impl StableRunArgs {
         }
         Ok(())
     }
-}
-
-/// Run `pushbot run stable`.
-pub fn run(g: &Global, cmd: RunCommand) -> CliResult {
-    let RunCommand::Stable(a) = cmd;
-    let e = StableEvalArgs {
-        run: a,
-        trials: 1,
-        random: None,
-        pusher: "diff-drive".into(),
-    };
-    eval_or_run(g, &e, true)
 }
 
 /// Run `pushbot eval stable`.

@@ -61,12 +61,18 @@ fn eval_in_sim(_global: &Global, _a: DeliveryArgs) -> CliResult {
 /// Run `pushbot collect`.
 #[cfg(feature = "sim")]
 pub fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
+    if a.port.is_some() {
+        return super::run::collect_on_robot(global, &a);
+    }
     super::strategy_sim::run_collect(global, a)
 }
 
 /// Without the `sim` feature there is nothing to collect in.
 #[cfg(not(feature = "sim"))]
-pub fn run_collect(_global: &Global, _a: CollectArgs) -> CliResult {
+pub fn run_collect(global: &Global, a: CollectArgs) -> CliResult {
+    if a.port.is_some() {
+        return super::run::collect_on_robot(global, &a);
+    }
     Err(super::no_simulated_target())
 }
 

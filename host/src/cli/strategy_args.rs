@@ -162,6 +162,16 @@ pub struct CollectArgs {
     /// Write the strategy as an SVG (Fig. 7 style).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Collect on a real robot on this serial port (with --camera), seen by the camera; a
+    /// stopped collection goes on from the samples already in --out.
+    #[arg(long, requires = "camera")]
+    pub port: Option<String>,
+    /// The overhead camera (/dev/videoN, a folder of frames, sim:HOST:PORT), with --port.
+    #[arg(long, requires = "port")]
+    pub camera: Option<String>,
+    /// The run's folder with --port (default: runs/collect-YYYYMMDD-HHMMSS).
+    #[arg(long = "run-dir", value_name = "DIR", requires = "port")]
+    pub run_dir: Option<PathBuf>,
     #[command(flatten)]
     pub active: ActiveArgs,
     #[command(flatten)]

@@ -9,6 +9,7 @@
 //! code runs against the simulated target at any speed.
 
 use std::collections::HashMap;
+use std::sync::{Arc, Mutex, RwLock, RwLockReadGuard};
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow, bail};
@@ -20,6 +21,7 @@ use super::grabber::FrameGrabber;
 use super::occlusion;
 
 mod look;
+pub mod watch;
 use crate::exec::io::{Rect, RobotIo, Workspace};
 use crate::link::LinkError;
 use crate::robot::{LinkOptions, Recovery, Robot, link_broke};
@@ -30,6 +32,7 @@ use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
 use crate::vision::tracking::TrackerParams;
 use pushbot_world::workspace::{object_bounds, outline_about};
+pub use watch::{Stopper, Watch};
 
 /// Settings of a [`LiveRobot`].
 #[derive(Debug, Clone, PartialEq)]
@@ -108,8 +111,15 @@ impl Default for LiveOptions {
 
 /// A robot on a serial port, seen by a camera.
 pub struct LiveRobot {
-    robot: Robot,
-    grabber: FrameGrabber,
+    /// The link; behind a lock that only a recovery of the link takes for writing, so a
+    /// [`Stopper`] reaches the robot while a primitive runs.
+    robot: Arc<RwLock<Robot>>,
+    grabber: Arc<FrameGrabber>,
+    /// What every look saw, for a view that shows it ([`LiveRobot::watch`]).
+    watch: Option<Arc<Mutex<Watch>>>,
+    /// The scene, for choosing another object ([`LiveRobot::set_object`]).
+    scene: Scene,
+    tracker_params: TrackerParams,
     pipeline: Pipeline,
     opts: LiveOptions,
     /// The object [`RobotIo::object_pose`] reports, if the scene has one.
@@ -144,7 +154,7 @@ pub struct LiveRobot {
 impl std::fmt::Debug for LiveRobot {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LiveRobot")
-            .field("port", &self.robot.path())
+            .field("port", &self.robot().path())
             .field("camera", &self.grabber.describe())
             .field("object", &self.object)
             .finish()
@@ -175,23 +185,7 @@ impl LiveRobot {
                 .find(|o| o.marker.is_some())
                 .or(scene.objects.first()),
         };
-        let marker = object
-            .and_then(|o| o.marker)
-            .map_or([0.0, 0.0], |m| [m.x, m.y]);
-        let outline = object.map_or(&[][..], |o| &o.outline);
-        let (object_radius, body) = object_bounds(outline, marker);
-        let outline = outline_about(outline, marker);
-        let table = Rect {
-            min: [0.0, 0.0],
-            max: [scene.table.width, scene.table.height],
-        };
-        let workspace = Workspace {
-            table,
-            boundary: table.inset(opts.boundary_inset),
-            robot_radius: scene.robot.bumper_radius,
-            object_radius,
-            body,
-        };
+        let (marker, outline, workspace) = object_frame(scene, object, opts.boundary_inset);
         let robot = Robot::connect(port, opts.link.clone())
             .with_context(|| format!("connecting to the robot on {port}"))?;
         robot
@@ -201,8 +195,10 @@ impl LiveRobot {
             })
             .context("configuring the robot's link watchdog")?;
         let t0_us = robot.telemetry().map_or(0, |t| t.time_us);
-        let grabber = FrameGrabber::open(camera, opts.fps)
-            .with_context(|| format!("opening the camera {camera}"))?;
+        let grabber = Arc::new(
+            FrameGrabber::open(camera, opts.fps)
+                .with_context(|| format!("opening the camera {camera}"))?,
+        );
         let layout = MarkerLayout::from_scene(scene);
         let families = layout.families();
         let lens = opts.lens.or(scene.camera.optics());
@@ -243,8 +239,11 @@ impl LiveRobot {
             None => None,
         };
         let mut live = LiveRobot {
-            robot,
+            robot: Arc::new(RwLock::new(robot)),
             grabber,
+            watch: None,
+            scene: scene.clone(),
+            tracker_params: params,
             pipeline,
             object: object.map(|o| o.id.clone()),
             marker,
@@ -280,8 +279,71 @@ impl LiveRobot {
     }
 
     /// The link to the robot.
-    pub fn link(&self) -> &Robot {
-        &self.robot
+    pub fn link(&self) -> RwLockReadGuard<'_, Robot> {
+        self.robot()
+    }
+
+    fn robot(&self) -> RwLockReadGuard<'_, Robot> {
+        self.robot
+            .read()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// A handle that stops the robot from another thread, at once, while a primitive runs.
+    pub fn stopper(&self) -> Stopper {
+        Stopper::new(Arc::clone(&self.robot))
+    }
+
+    /// The camera, shared: a view may read its newest frames while tasks run.
+    pub fn grabber(&self) -> Arc<FrameGrabber> {
+        Arc::clone(&self.grabber)
+    }
+
+    /// What every look sees from now on (the camera frame's detections drawn over it, the
+    /// tracked poses), kept in the returned cell.
+    pub fn watch(&mut self) -> Arc<Mutex<Watch>> {
+        Arc::clone(self.watch.get_or_insert_with(Arc::default))
+    }
+
+    /// Report `id`'s pose as [`RobotIo::object_pose`] from now on (the object a task pushes).
+    pub fn set_object(&mut self, id: &str) -> Result<()> {
+        let object = self
+            .scene
+            .object(id)
+            .ok_or_else(|| anyhow!("scene {} has no object {id:?}", self.scene.name))?;
+        let (marker, outline, workspace) =
+            object_frame(&self.scene, Some(object), self.opts.boundary_inset);
+        (self.marker, self.outline, self.workspace) = (marker, outline, workspace);
+        self.object = Some(id.to_owned());
+        self.fresh = false;
+        Ok(())
+    }
+
+    /// The recording every look goes into, if any.
+    pub fn recording_handle(&self) -> Option<crate::recording::RecordingHandle> {
+        self.opts.recording.clone()
+    }
+
+    /// The scene this robot's table is.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Start recording into `recording` (a new session in it), or stop with `None`.
+    pub fn record_into(&mut self, recording: Option<crate::recording::RecordingHandle>) {
+        self.opts.recording = recording.clone();
+        self.recording = recording.map(|h| {
+            let info = crate::recording::writer::SessionInfo {
+                label: &self.scene.name,
+                scene: Some(&self.scene),
+                layout: self.pipeline.layout(),
+                calibration: self.pipeline.calibration(),
+                tracker: self.tracker_params,
+                detector: self.opts.detector,
+                whole_frames: false,
+            };
+            crate::recording::live::LiveRecording::start(&h, &self.robot(), &info)
+        });
     }
 
     /// The calibration in use.
@@ -296,7 +358,7 @@ impl LiveRobot {
 
     /// Every recovery of the link so far, in order.
     pub fn recoveries(&self) -> Vec<Recovery> {
-        self.robot.recoveries()
+        self.robot().recoveries()
     }
 
     /// Frames processed so far.
@@ -318,7 +380,7 @@ impl LiveRobot {
 
     /// The robot's clock since connecting, s (from its latest telemetry).
     pub fn robot_clock(&self) -> f64 {
-        self.robot
+        self.robot()
             .telemetry()
             .map_or(0.0, |t| t.time_us.saturating_sub(self.t0_us) as f64 * 1e-6)
     }
@@ -355,11 +417,18 @@ impl LiveRobot {
         // loaded host can let the link watchdog fire again between the clear and the retry).
         const ATTEMPTS: usize = 4;
         for attempt in 0..ATTEMPTS {
-            match run(&self.robot) {
+            let outcome = run(&self.robot());
+            match outcome {
+                Ok(Outcome::Fault(f)) if f.contains(pushbot_protocol::Faults::EMERGENCY_STOP) => {
+                    bail!(
+                        "{what} on {}: the robot was emergency-stopped",
+                        self.robot().path()
+                    );
+                }
                 Ok(Outcome::Fault(f)) if f.contains(pushbot_protocol::Faults::LINK_LOST) => {
                     let cause = format!(
                         "{what} on {} was cut short: the robot's link watchdog fired ({})",
-                        self.robot.path(),
+                        self.robot().path(),
                         crate::link::FaultNames(f)
                     );
                     return self.recover_link(what, cause);
@@ -377,7 +446,7 @@ impl LiveRobot {
                 Err(e) if attempt + 1 < ATTEMPTS && faulted_refusal(&e) == Some(LINK_ONLY) => {
                     // The link broke while the robot stood (its watchdog fired between two
                     // primitives): recover, then send the refused motion again — it never ran.
-                    let cause = format!("{what} on {}: {e:#}", self.robot.path());
+                    let cause = format!("{what} on {}: {e:#}", self.robot().path());
                     self.recover_link(what, cause)?;
                 }
                 Err(e) if attempt + 1 < ATTEMPTS && faulted_refusal(&e).is_some() => {
@@ -385,10 +454,10 @@ impl LiveRobot {
                     self.clear_faults()?;
                 }
                 Err(e) if e.downcast_ref::<LinkError>().is_some_and(link_broke) => {
-                    let cause = format!("{what} on {}: {e:#}", self.robot.path());
+                    let cause = format!("{what} on {}: {e:#}", self.robot().path());
                     return self.recover_link(what, cause);
                 }
-                Err(e) => return Err(e.context(format!("{what} on {}", self.robot.path()))),
+                Err(e) => return Err(e.context(format!("{what} on {}", self.robot().path()))),
             }
         }
         bail!("the robot stayed faulted")
@@ -405,8 +474,10 @@ impl LiveRobot {
             bail!("{cause}; the link broke {MOST_IN_A_ROW} times in a row: giving up");
         }
         self.recoveries_in_a_row += 1;
-        let seq = self.robot.last_seq();
+        let seq = self.robot().last_seq();
         self.robot
+            .write()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
             .recover(&cause, Some((seq, what.command())))
             .with_context(|| format!("recovering the link after: {cause}"))?;
         // A robot that restarted counts its odometry from zero again.
@@ -417,14 +488,42 @@ impl LiveRobot {
     fn clear_faults(&mut self) -> Result<()> {
         // A fault clears only once its cause has been quiet for a while (robot time).
         for _ in 0..50 {
-            if self.robot.clear_faults()?.is_empty() {
+            let robot = self.robot();
+            if robot.clear_faults()?.is_empty() {
                 return Ok(());
             }
-            let after = self.robot.telemetry().map(|t| t.time_us + 100_000);
-            let _ = self.robot.wait_telemetry(after);
+            let after = robot.telemetry().map(|t| t.time_us + 100_000);
+            let _ = robot.wait_telemetry(after);
         }
         bail!("the robot's faults would not clear")
     }
+}
+
+/// Where the object's marker is in its body frame, its outline about the marker, and the
+/// workspace it is pushed in (the table inset by `inset`).
+fn object_frame(
+    scene: &Scene,
+    object: Option<&pushbot_world::scene::Object>,
+    inset: f64,
+) -> ([f64; 2], Vec<[f64; 2]>, Workspace) {
+    let marker = object
+        .and_then(|o| o.marker)
+        .map_or([0.0, 0.0], |m| [m.x, m.y]);
+    let outline = object.map_or(&[][..], |o| &o.outline);
+    let (object_radius, body) = object_bounds(outline, marker);
+    let outline = outline_about(outline, marker);
+    let table = Rect {
+        min: [0.0, 0.0],
+        max: [scene.table.width, scene.table.height],
+    };
+    let workspace = Workspace {
+        table,
+        boundary: table.inset(inset),
+        robot_radius: scene.robot.bumper_radius,
+        object_radius,
+        body,
+    };
+    (marker, outline, workspace)
 }
 
 /// Only the link's own fault.

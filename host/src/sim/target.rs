@@ -129,3 +129,28 @@ impl SimTarget {
         self.sim.shutdown()
     }
 }
+
+impl crate::task::session::Target for SimTarget {
+    fn truth(&self) -> Option<crate::task::session::Truth> {
+        let t = self.sim.truth();
+        Some(crate::task::session::Truth {
+            t: t.t,
+            robot: [t.pose.x, t.pose.y, t.pose.theta],
+            wheel_speed: t.wheel_speed,
+            objects: self
+                .sim
+                .objects()
+                .into_iter()
+                .map(|(id, p)| (id, [p.x, p.y, p.theta]))
+                .collect(),
+        })
+    }
+
+    fn port(&self) -> String {
+        self.sim.serial_path().to_string()
+    }
+
+    fn camera(&self) -> String {
+        self.camera.clone().unwrap_or_default()
+    }
+}

@@ -218,6 +218,11 @@ impl Pipeline {
         &self.calibration
     }
 
+    /// The markers it knows.
+    pub fn layout(&self) -> &MarkerLayout {
+        &self.layout
+    }
+
     /// The regions around each body's predicted marker, or `None` when the whole frame is due.
     fn regions(&self, frame: &Frame) -> Option<Vec<detection::Region>> {
         if self.roi.full_every <= 1

@@ -35,7 +35,7 @@ impl LiveRobot {
         let (n, frame) = self.grabber.next_after(after, self.opts.frame_timeout)?;
         // The robot stands still while the host looks: its odometry now is its odometry when
         // the frame was taken, and the tracker predicts the primitive's motion from it.
-        let odometry = self.robot.telemetry().map(|t| {
+        let odometry = self.robot().telemetry().map(|t| {
             let p = t.pose;
             [f64::from(p.x), f64::from(p.y), f64::from(p.theta)]
         });
@@ -55,12 +55,20 @@ impl LiveRobot {
         }
         if let Some(rec) = &self.recording {
             rec.look(
-                &self.robot,
+                &self.robot(),
                 &frame,
                 &r,
                 self.pipeline.calibration(),
                 odometry,
             );
+        }
+        if let Some(w) = &self.watch {
+            let plan = self.view.as_ref().map_or(&[][..], |v| &v.plan[..]);
+            let overlay =
+                crate::exec::view::overlay_svg(&frame, &r, self.pipeline.calibration(), plan);
+            w.lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .update(&r, overlay);
         }
         for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
             let p = Pose2::new(t.pose.x, t.pose.y, t.pose.theta);
