@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
+pub mod console;
 #[cfg(feature = "sim")]
 mod data_need;
 pub mod demo;
@@ -106,6 +107,9 @@ pub enum Command {
     /// The whole system in one command: the built-in simulated target (or --port/--camera),
     /// a learned delivery, a rearrangement and a stable push, and a report folder.
     Demo(demo::DemoArgs),
+    /// The operator's page in the browser: the camera, the table, goals by clicking, plan,
+    /// run, pause, stop and an emergency stop.
+    Console(console::ConsoleArgs),
     /// Talk to the robot: info, move, spin, stop, estop, clear-faults.
     Robot(robot::RobotArgs),
     /// Pushing mechanics of an object: STABLE per edge, controllability (Lynch & Mason §3).
@@ -297,6 +301,10 @@ pub const EXAMPLES: &[(&str, &str)] = &[
         "run stable",
         "pushbot run stable --scene fig15 --goal 0.6,0.5,90",
     ),
+    (
+        "console",
+        "pushbot console --scene lau-obstacles\n  pushbot console --port /dev/ttyACM0 --camera /dev/video0 --scene my-table.toml",
+    ),
     ("scene", "pushbot scene check --scene my-table.toml"),
     (
         "scene check",
@@ -409,6 +417,7 @@ pub fn run(cli: Cli) -> CliResult {
     let Cli { global, command } = cli;
     match command {
         Command::Demo(args) => demo::run(&global, args),
+        Command::Console(a) => console::run(&global, &a),
         Command::Robot(args) => robot::run(&global, args),
         Command::Mechanics(a) => stable::run_mechanics(&global, &a),
         Command::Plan(PlanCommand::Rearrange(args)) => rearrange::plan(&global, args),

@@ -167,8 +167,7 @@ fn deliver(g: &Global, a: &DeliverArgs) -> CliResult {
     run_task(g, &scene, Task::Deliver(task), &a.robot)
 }
 
-/// The samples of the strategy at `path`; on the built-in target a missing one is collected
-/// first, in simulation.
+/// The samples of the strategy at `path` ([`crate::task::deliver::load_strategy`]).
 fn strategy_samples(
     g: &Global,
     scene: &pushbot_world::Scene,
@@ -176,73 +175,14 @@ fn strategy_samples(
     path: &std::path::Path,
     robot: &RobotArgs,
 ) -> Result<Vec<crate::strategy::sample::Sample>, CliError> {
-    if path.exists() {
-        let f = crate::strategy::store::load(path)
-            .map_err(|e| CliError::bad_input(format!("--strategy {}: {e}", path.display())))?;
-        if f.object != object {
-            return Err(CliError::bad_input(format!(
-                "--strategy {}: it is the strategy of {:?}, not of {object:?}",
-                path.display(),
-                f.object
-            )));
-        }
-        return Ok(f.samples);
-    }
-    if robot.port.is_some() {
-        return Err(CliError::bad_input(format!(
-            "no strategy {}: collect one on the robot first with `pushbot collect --object \
-             {object} --port PORT --camera CAMERA --out {}` (or give --method dipole)",
-            path.display(),
-            path.display()
-        )));
-    }
-    collect_in_sim(g, scene, object, path)
-}
-
-#[cfg(feature = "sim")]
-fn collect_in_sim(
-    g: &Global,
-    scene: &pushbot_world::Scene,
-    object: &str,
-    path: &std::path::Path,
-) -> Result<Vec<crate::strategy::sample::Sample>, CliError> {
-    if !g.json {
+    if !path.exists() && robot.port.is_none() && !g.json {
         eprintln!(
             "no strategy {}: collecting one for {object} in simulation first",
             path.display()
         );
     }
-    let pb = super::progress_bar(g, crate::exec::collect::DEFAULT_INITIAL as u64);
-    let sim = crate::sim::robot::SimRobotOptions {
-        seed: g.seed,
-        ..Default::default()
-    };
-    let params = crate::exec::collect::CollectParams {
-        seed: g.seed,
-        ..Default::default()
-    };
-    let (samples, _) = crate::experiments::delivery::collect_or_load(
-        scene,
-        Some(object),
-        path,
-        sim,
-        &params,
-        crate::strategy::regression::KernelParams::default(),
-        &pb,
-    )
-    .map_err(CliError::Failed)?;
-    pb.finish_and_clear();
-    Ok(samples)
-}
-
-#[cfg(not(feature = "sim"))]
-fn collect_in_sim(
-    _: &Global,
-    _: &pushbot_world::Scene,
-    _: &str,
-    _: &std::path::Path,
-) -> Result<Vec<crate::strategy::sample::Sample>, CliError> {
-    Err(super::no_simulated_target())
+    crate::task::deliver::load_strategy(scene, object, path, robot.port.is_none(), g.seed)
+        .map_err(bad)
 }
 
 fn rearrange(g: &Global, a: &RearrangeArgs) -> CliResult {
@@ -294,7 +234,10 @@ pub fn where_of(g: &Global, robot: &RobotArgs) -> Result<Where, CliError> {
                 )));
             }
             #[cfg(not(feature = "sim"))]
-            return Err(super::no_simulated_target());
+            {
+                let _ = g;
+                Err(super::no_simulated_target())
+            }
             #[cfg(feature = "sim")]
             Ok(Where::Builtin {
                 speed: robot.sim_speed,
@@ -315,30 +258,6 @@ pub fn live_options(g: &Global, at: &Where) -> Result<LiveOptions, CliError> {
     })
 }
 
-/// The default run folder: `runs/TASK-YYYYMMDD-HHMMSS` (UTC).
-pub fn default_folder(task: &str) -> PathBuf {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    let (days, rest) = ((secs / 86_400) as i64, secs % 86_400);
-    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    PathBuf::from("runs").join(format!(
-        "{task}-{y:04}{m:02}{d:02}-{:02}{:02}{:02}",
-        rest / 3600,
-        rest / 60 % 60,
-        rest % 60
-    ))
-}
-
 /// Run `task` on the robot `robot` says, over `scene`'s table, into its folder; prints the
 /// events (text on stderr, or the summary as JSON).
 pub fn run_task(
@@ -357,7 +276,7 @@ pub fn run_task(
     let dir = robot
         .out
         .clone()
-        .unwrap_or_else(|| default_folder(task.name()));
+        .unwrap_or_else(|| crate::task::folder::default_folder(task.name()));
     let folder = std::sync::Arc::new(RunFolder::create(&dir).map_err(CliError::BadInput)?);
     let mut session = Session::open(scene, &at, opts).map_err(CliError::Failed)?;
     session.live.record_into(Some(folder.recording()));

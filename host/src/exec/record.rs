@@ -177,7 +177,7 @@ impl RobotIo for Recorder<'_> {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "sim"))]
 mod tests {
     use super::*;
     use crate::sim::robot::{SimRobot, SimRobotOptions};

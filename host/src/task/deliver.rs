@@ -255,3 +255,86 @@ pub fn reach(scene: &pushbot_world::Scene, object: &str) -> Reach {
 pub(crate) fn round1(x: f64) -> f64 {
     (x * 10.0).round() / 10.0
 }
+
+/// The samples of the strategy for `object` at `path`. A missing file is collected there first
+/// in simulation when `builtin` (the built-in target's world is the simulator's); on a real
+/// robot it must be collected on the robot (`pushbot collect --port`).
+pub fn load_strategy(
+    scene: &pushbot_world::Scene,
+    object: &str,
+    path: &std::path::Path,
+    builtin: bool,
+    seed: u64,
+) -> Result<Vec<Sample>, GoalError> {
+    if path.exists() {
+        let f = crate::strategy::store::load(path)
+            .map_err(|e| GoalError(format!("the strategy {}: {e}", path.display())))?;
+        if f.object != object {
+            return Err(GoalError(format!(
+                "the strategy {} is for {:?}, not for {object:?}",
+                path.display(),
+                f.object
+            )));
+        }
+        return Ok(f.samples);
+    }
+    if !builtin {
+        return Err(GoalError(format!(
+            "no strategy {}: collect one on the robot first (`pushbot collect --object {object} \
+             --port PORT --camera CAMERA --out {}`, or Collect in the console), or push with \
+             the dipole field",
+            path.display(),
+            path.display()
+        )));
+    }
+    collect_in_sim(scene, object, path, seed)
+}
+
+#[cfg(feature = "sim")]
+fn collect_in_sim(
+    scene: &pushbot_world::Scene,
+    object: &str,
+    path: &std::path::Path,
+    seed: u64,
+) -> Result<Vec<Sample>, GoalError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| GoalError(format!("creating {}: {e}", dir.display())))?;
+    }
+    let sim = crate::sim::robot::SimRobotOptions {
+        seed,
+        ..Default::default()
+    };
+    let params = crate::exec::collect::CollectParams {
+        seed,
+        ..Default::default()
+    };
+    crate::experiments::delivery::collect_or_load(
+        scene,
+        Some(object),
+        path,
+        sim,
+        &params,
+        KernelParams::default(),
+        &indicatif::ProgressBar::hidden(),
+    )
+    .map(|(s, _)| s)
+    .map_err(|e| {
+        GoalError(format!(
+            "collecting a strategy for {object} in simulation: {e:#}"
+        ))
+    })
+}
+
+#[cfg(not(feature = "sim"))]
+fn collect_in_sim(
+    _: &pushbot_world::Scene,
+    object: &str,
+    path: &std::path::Path,
+    _: u64,
+) -> Result<Vec<Sample>, GoalError> {
+    Err(GoalError(format!(
+        "no strategy {} for {object}, and this build has no simulator to collect one in",
+        path.display()
+    )))
+}

@@ -10,7 +10,7 @@
 //! |---|---|---|
 //! | [`deliver`] | Lau, Mitani & Igarashi §III-E (Algorithm 2), the dipole field baseline | [`crate::exec::deliver_path`], [`crate::exec::deliver`] |
 //! | [`rearrange`] | Ben-Shahar & Rivlin §IV–V (cost map, restoration; the practical mode) | [`crate::exec::rearrange`] |
-//! | [`stable`] | Lynch & Mason §4 (stable pushes), driven closed loop | [`crate::exec::stable_feedback`] |
+//! | `stable` | Lynch & Mason §4 (stable pushes), driven closed loop | [`crate::exec::stable_feedback`] |
 //! | [`collect`] | Lau, Mitani & Igarashi §III-C/D (Algorithm 1) | [`crate::exec::collect`] |
 
 pub mod collect;
