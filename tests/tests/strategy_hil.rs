@@ -13,8 +13,9 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     pushbot_tests::init_logging();
     // About 2 min on a 2-core machine; a run that stops making progress fails instead of
     // holding up the suite. 50 samples: what is tested here is collecting and delivering
-    // through the port and the camera; how good a strategy gets with how many samples is
-    // measured in process (`strategy_sim`, `strategy_active`, `eval delivery --figure 7`).
+    // through the port and the camera, as an operator does on a real robot (`pushbot collect`,
+    // then `pushbot run deliver`); how good a strategy gets with how many samples is measured
+    // in process (`strategy_sim`, `strategy_active`, `eval delivery --figure 7`).
     let _limit = pushbot_tests::WallLimit::arm(
         "collect_and_deliver_one_object_through_the_port_and_the_camera",
         std::time::Duration::from_secs(15 * 60),
@@ -23,31 +24,58 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     let goal = scene.goals[0].pose;
     let t =
         SimTarget::start(&scene, 21, SIM_SPEED, None, None).expect("start the simulated target");
-    let watchdog = ((1000.0 * SIM_SPEED) as u16).to_string();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let strategy = dir.path().join("object.strategy");
+    let strategy = strategy.to_str().expect("utf-8 path");
+    let collect_dir = dir.path().join("collect");
     let argv = [
         "pushbot",
         "--json",
-        "eval",
-        "delivery",
-        "--hil",
+        "collect",
+        "--object",
+        "object",
+        "--scene",
+        "lau-irregular",
         "--port",
         t.port(),
         "--camera",
         t.camera(),
-        "--scene",
-        "lau-irregular",
-        "--method",
-        "learned",
+        "--out",
+        strategy,
         "--initial",
         "50",
         "--streak",
         "0",
-        "--trials",
-        "1",
-        "--time-limit",
-        "480",
-        "--watchdog-ms",
-        &watchdog,
+        "--run-dir",
+        collect_dir.to_str().expect("utf-8 path"),
+    ];
+    let st = run(Cli::try_parse_from(argv).expect("arguments parse")).expect("collects");
+    assert_eq!(st, Status::Success);
+    assert!(
+        std::path::Path::new(strategy).is_file(),
+        "no strategy written"
+    );
+    let goal_arg = format!("{},{}", goal.x, goal.y);
+    let deliver_dir = dir.path().join("deliver");
+    let argv = [
+        "pushbot",
+        "--json",
+        "run",
+        "deliver",
+        "--object",
+        "object",
+        "--scene",
+        "lau-irregular",
+        "--goal",
+        &goal_arg,
+        "--strategy",
+        strategy,
+        "--port",
+        t.port(),
+        "--camera",
+        t.camera(),
+        "--out",
+        deliver_dir.to_str().expect("utf-8 path"),
     ];
     let st = run(Cli::try_parse_from(argv).expect("arguments parse")).expect("runs");
     // Ground truth: the object's marker (at the object's origin) within 2.2 cm of the goal.
@@ -55,6 +83,9 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     let d = (o.x - goal.x).hypot(o.y - goal.y);
     assert_eq!(st, Status::Success, "object ended {d:.3} m from the goal");
     assert!(d < 0.03, "object ended {d:.3} m from the goal");
+    for f in ["run.mcap", "report.html", "run.log", "summary.json"] {
+        assert!(deliver_dir.join(f).is_file(), "the run's folder has no {f}");
+    }
     t.shutdown().expect("sim ran cleanly");
 }
 

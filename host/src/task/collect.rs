@@ -109,7 +109,9 @@ impl Collect {
             &format!("Collect a pushing strategy for {}", self.object),
             "Lau, Mitani & Igarashi §III-C/D (Algorithm 1)",
         );
-        st.success = rep.streak_reached;
+        // A streak of 0 asks for no evaluation: the collection is done when its samples are.
+        let done = rep.streak_reached || self.params.streak == 0;
+        st.success = done;
         st.number("Samples", rep.total_samples);
         st.number("Samples resumed from the file", resumed);
         st.number("Goal queries", rep.queries);
@@ -118,7 +120,9 @@ impl Collect {
             "Minutes of collection",
             super::deliver::round1(rep.total_minutes),
         );
-        let message = if rep.streak_reached {
+        let message = if self.params.streak == 0 {
+            format!("{} samples (no evaluation streak asked)", rep.total_samples)
+        } else if rep.streak_reached {
             format!(
                 "{} samples; the last {} deliveries succeeded",
                 rep.total_samples, self.params.streak
@@ -140,7 +144,7 @@ impl Collect {
         });
         st.notes.push(message.clone());
         Ok(Outcome {
-            success: rep.streak_reached,
+            success: done,
             stopped: None,
             message,
             summary: serde_json::to_value(&rep).unwrap_or_default(),
