@@ -1,6 +1,8 @@
-//! `pushbot scene check` on the checks of issue 18: what it normalised (a clockwise outline) is
-//! said in text and JSON; a goal inside an obstacle and a bad `[stable]` value exit 2 naming
-//! the file, line, column and field; a 100 000-vertex circle is a simple polygon.
+//! `pushbot scene check` on the scene checks: what it normalised (a clockwise outline, a fine
+//! outline simplified) is said in text and JSON; a goal inside an obstacle and a bad `[stable]`
+//! value exit 2 naming the file, line, column and field; a 100 000-vertex circle is a simple
+//! polygon; a 200 000-vertex circular object loads, checks and plans in every command that
+//! takes a scene.
 
 use pushbot_tests::{Run, run_bin};
 
@@ -129,4 +131,102 @@ fn a_100000_vertex_circle_obstacle_is_simple() {
     let (_, r) = check(&dir, "circle.toml", &text, false);
     assert_eq!(r.code, Some(0), "{r:?}");
     assert!(r.stdout.contains("ok"), "{r:?}");
+}
+
+/// A scene whose one object is a circle of radius 0.4 m drawn with `n` vertices, and `section`.
+fn fine_circle(n: usize, section: &str) -> String {
+    let pts: Vec<String> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            format!("[{:.7}, {:.7}]", 0.4 * a.cos(), 0.4 * a.sin())
+        })
+        .collect();
+    format!(
+        "name = \"fine-circle\"\n[table]\nwidth = 2.4\nheight = 1.2\n\
+         [robot]\nstart = {{ x = 0.1, y = 0.1, theta = 0.0 }}\n\
+         [[objects]]\nid = \"disc\"\noutline = [{}]\npose = {{ x = 0.6, y = 0.6, theta = 0.0 }}\n\
+         mass = 0.5\nsupport_friction = 0.3\npusher_friction = 0.5\n\
+         [[goals]]\nobject = \"disc\"\npose = {{ x = 1.7, y = 0.6, theta = 0.0 }}\n{section}",
+        pts.join(", ")
+    )
+}
+
+#[test]
+fn a_200000_vertex_circular_object_is_simplified_and_every_command_takes_it() {
+    let _limit = pushbot_tests::WallLimit::arm(
+        "the fine-outline commands",
+        std::time::Duration::from_secs(300),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let n = 200_000;
+    // scene check: the simplification is said, with how many vertices were kept.
+    let (path, r) = check(&dir, "disc.toml", &fine_circle(n, ""), false);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    assert!(
+        r.stdout.contains("has 200000 vertices; simplified to"),
+        "{}",
+        r.stdout
+    );
+    let (_, j) = check(&dir, "disc.toml", &fine_circle(n, ""), true);
+    let v: serde_json::Value = serde_json::from_str(&j.stdout).expect("JSON");
+    let note = v.to_string();
+    assert!(
+        note.contains("objects[0].outline") && note.contains("within 0.100 mm"),
+        "{note}"
+    );
+    let kept: usize = r
+        .stdout
+        .split("simplified to ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|k| k.parse().ok())
+        .expect("the number of vertices kept");
+    assert!((16..2000).contains(&kept), "kept {kept} vertices");
+    let _ = path;
+    // The planners and the simulator take it (a plan, or a plain "no plan": exit 0 or 1).
+    let stable = dir.path().join("stable.toml");
+    std::fs::write(
+        &stable,
+        fine_circle(
+            n,
+            "[stable]\nobject = \"disc\"\nedges = [0, 50000, 100000, 150000]\n\
+             goal_xy_frac = 0.25\ngoal_theta_deg = 5.0\n\
+             pusher = { kind = \"omni\", width = 0.1, depth = 0.08 }\n\
+             planner = { a = 1, b = 5, c = 10, step_frac = 0.3, grid_xy_frac = 0.5, \
+             grid_theta_deg = 6.0, max_cost = 3000, max_nodes = 2000 }\n",
+        ),
+    )
+    .unwrap();
+    let rearrange = dir.path().join("rearrange.toml");
+    std::fs::write(
+        &rearrange,
+        fine_circle(n, "[rearrange]\ncell = 0.1\nrobot_size = 1\n"),
+    )
+    .unwrap();
+    let (stable, rearrange) = (
+        stable.display().to_string(),
+        rearrange.display().to_string(),
+    );
+    for (bin, args) in [
+        (
+            "pushbot",
+            vec!["plan", "stable", "--scene", stable.as_str()],
+        ),
+        (
+            "pushbot",
+            vec!["plan", "rearrange", "--scene", rearrange.as_str()],
+        ),
+        (
+            "pushbot-sim",
+            vec!["bench", "--scene", stable.as_str(), "--seconds", "0.2"],
+        ),
+    ] {
+        let r = run_bin(bin, &args);
+        assert!(
+            matches!(r.code, Some(0 | 1)) && !r.stderr.contains("panicked"),
+            "{bin} {}: {r:?}",
+            args.join(" ")
+        );
+        assert!(!r.stderr.contains("not simple"), "{r:?}");
+    }
 }

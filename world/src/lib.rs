@@ -4,6 +4,7 @@
 //! * [`geometry`] — outlines as convex parts and their overlaps, on `parry2d`;
 //! * [`enclosing_circle`] — the smallest circle enclosing a point set (Welzl);
 //! * [`polygon`] — simple-polygon checks in O(n log n) and winding normalisation;
+//! * [`simplify`] — fine outlines simplified within 0.1 mm (Douglas–Peucker, `geo`);
 //! * [`board`] — the lens-calibration board: an AprilTag grid and its layout file;
 //! * [`body`] — the robot's build (round bumper, front plate, switches);
 //! * [`scene`] — the one scene format (TOML), its validation with file:line:col errors, and
@@ -32,6 +33,7 @@ pub mod polygon;
 pub mod pose;
 pub mod presets;
 pub mod scene;
+pub mod simplify;
 pub mod workspace;
 
 pub use pose::{Pose, wrap_angle};

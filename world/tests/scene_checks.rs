@@ -1,6 +1,7 @@
-//! The scene checks of issue 18: clockwise outlines normalised (and said so), goals and starts
-//! inside obstacles or off the table refused, the planners' sections checked with their field
-//! paths, marker heights, the camera's intrinsics file.
+//! The scene checks: clockwise outlines normalised (and said so), fine outlines simplified (and
+//! said so, the stable task's edges following them), goals and starts inside obstacles or off
+//! the table refused, the planners' sections checked with their field paths, marker heights,
+//! the camera's intrinsics file.
 
 use pushbot_world::Scene;
 use pushbot_world::polygon::signed_area;
@@ -493,4 +494,74 @@ fn an_inline_lens_a_pose_an_exposure_and_occluders_are_read_and_checked() {
     .expect("a hand from 1 s on");
     let hand = &ok.camera.occluders[0];
     assert!(!hand.shown_at(0.5) && hand.shown_at(1.0) && hand.shown_at(1e9));
+}
+
+/// `BASE` with an obstacle of `outline` added.
+fn with_obstacle(outline: &[[f64; 2]]) -> String {
+    let pts: Vec<String> = outline
+        .iter()
+        .map(|p| format!("[{:.7}, {:.7}]", p[0], p[1]))
+        .collect();
+    format!("{BASE}\n[[obstacles]]\noutline = [{}]\n", pts.join(", "))
+}
+
+#[test]
+fn a_fine_obstacle_is_simplified_within_a_tenth_of_a_millimetre_and_said_so() {
+    let n = 5000;
+    let circle: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            [0.3 + 0.08 * a.cos(), 0.2 + 0.08 * a.sin()]
+        })
+        .collect();
+    let (scene, notes) = Scene::from_toml_noted(&with_obstacle(&circle), "fine.toml").unwrap();
+    let kept = &scene.obstacles[2].outline;
+    assert!(
+        kept.len() < 200 && kept.len() >= 16,
+        "{} vertices kept",
+        kept.len()
+    );
+    // Every vertex as given lies within the tolerance of the simplified outline.
+    let dist = |p: [f64; 2]| {
+        (0..kept.len())
+            .map(|i| {
+                let (a, b) = (kept[i], kept[(i + 1) % kept.len()]);
+                let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+                let t = (((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / (ex * ex + ey * ey))
+                    .clamp(0.0, 1.0);
+                (p[0] - a[0] - t * ex).hypot(p[1] - a[1] - t * ey)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let worst = circle.iter().map(|&p| dist(p)).fold(0.0, f64::max);
+    assert!(
+        worst <= 1e-4 + 1e-12,
+        "a vertex {worst} m off the simplified outline"
+    );
+    let note = notes
+        .iter()
+        .find(|n| n.field == "obstacles[2].outline")
+        .expect("a note on the simplified obstacle");
+    assert!(
+        note.message
+            .contains(&format!("has {n} vertices; simplified to {}", kept.len())),
+        "{}",
+        note.message
+    );
+}
+
+#[test]
+fn an_outline_too_rough_to_simplify_is_refused_with_its_field() {
+    // A star of 30 000 spikes 2 mm deep: nothing can go within 0.1 mm.
+    let n = 30_000;
+    let star: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = if i % 2 == 0 { 0.08 } else { 0.078 };
+            [0.3 + r * a.cos(), 0.2 + r * a.sin()]
+        })
+        .collect();
+    let e = Scene::from_toml(&with_obstacle(&star), "rough.toml").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("obstacles[2].outline"), "{e}");
+    assert!(e.to_string().contains("at most 20000"), "{e}");
 }

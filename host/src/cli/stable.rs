@@ -46,9 +46,15 @@ pub struct PlanStableArgs {
     /// differential drive, with the Dubins path of its tightest stable turns.
     #[arg(long)]
     pub exact_goal: bool,
-    /// Draw the plan as SVG into this file.
+    /// Draw the plan as SVG into this file (with no plan: the tree the search explored).
     #[arg(long)]
     pub svg: Option<std::path::PathBuf>,
+    /// Most configurations the search expands (overrides the scene's planner.max_nodes).
+    #[arg(long, value_name = "N")]
+    pub max_nodes: Option<usize>,
+    /// Most a plan may cost (overrides the scene's planner.max_cost).
+    #[arg(long, value_name = "COST")]
+    pub max_cost: Option<u32>,
 }
 
 /// `pushbot bench stable`.
@@ -176,7 +182,13 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
         b: a.b,
         c: parse_c(&a.c)?,
     };
-    let problem = scene.problem(costs).map_err(CliError::BadInput)?;
+    let mut problem = scene.problem(costs).map_err(CliError::BadInput)?;
+    if let Some(n) = a.max_nodes {
+        problem.params.max_nodes = n;
+    }
+    if let Some(c) = a.max_cost {
+        problem.params.max_cost = c;
+    }
     let mut p = plan(&problem);
     if a.exact_goal && p.found {
         let t = p.plan_time_ms;
@@ -207,10 +219,7 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", path.display())))?;
     }
     let transit_length: f64 = p.transits.iter().map(|t| t.length).sum::<f64>() + 0.0;
-    // Why there is no plan, when it was decided before the search.
-    let no_plan = (!p.found && p.nodes_expanded == 0)
-        .then(|| crate::planner::stable::reach::unreachable(&problem))
-        .flatten();
+    let no_plan = crate::planner::stable::no_plan::why(&problem, &p);
     if scene.outline_reversed && !g.json {
         println!(
             "note: the object's outline was clockwise and is stored counter-clockwise; edges \
@@ -253,13 +262,13 @@ pub fn run_plan(g: &Global, a: &PlanStableArgs) -> CliResult {
             transit_length
         );
     } else {
-        match &no_plan {
-            Some(u) => println!("no plan: {u}"),
-            None => println!(
-                "no plan: {} nodes expanded in {:.1} ms",
-                p.nodes_expanded, p.plan_time_ms
-            ),
-        }
+        let why = no_plan
+            .as_ref()
+            .map_or_else(String::new, |u| format!(": {u}"));
+        println!(
+            "no plan ({} nodes expanded in {:.1} ms){why}",
+            p.nodes_expanded, p.plan_time_ms
+        );
     }
     Ok(if p.found {
         Status::Success

@@ -417,6 +417,7 @@ mod tests {
             steps: vec![step(0, 0), step(0, 0), step(1, 0)],
             transits: vec![],
             exact_goal: false,
+            search: Default::default(),
         };
         let a = arcs(&p, &plan);
         assert_eq!(a.len(), 2, "{a:?}");

@@ -12,7 +12,7 @@ use pushbot_protocol::{
 };
 
 use super::client::{
-    Answer, Client, ClientOptions, Event, Handshake, HostTime, MotionEnd, heartbeat_due,
+    Answer, Client, ClientOptions, Event, Handshake, Heard, HostTime, MotionEnd, heartbeat_due,
 };
 
 fn ms(v: u64) -> HostTime {
@@ -355,14 +355,20 @@ fn an_unanswered_hello_is_resent_until_the_hello_timeout() {
     let mut c = Client::new(ms(0), opts());
     let seq = c.hello(ms(0));
     c.pause_heartbeats(true);
-    // 2 s / 150 ms: 13 attempts.
-    for i in 1..=13u64 {
+    // 1.5 s / 150 ms: 10 attempts.
+    for i in 1..=10u64 {
         c.handle_timeout(ms(150 * i));
     }
-    let frames = sent(&mut c, ms(2000)).1;
-    assert_eq!(frames.len(), 13);
+    let frames = sent(&mut c, ms(1500)).1;
+    assert_eq!(frames.len(), 10);
     assert!(frames.iter().all(|f| f.seq == seq));
-    assert_eq!(c.handshake(), Some(Handshake::NoAnswer { attempts: 13 }));
+    assert_eq!(
+        c.handshake(),
+        Some(Handshake::NoAnswer {
+            attempts: 10,
+            heard: Heard::Nothing
+        })
+    );
 }
 
 #[test]

@@ -4,6 +4,8 @@ use std::fmt;
 
 use pushbot_protocol::{Faults, NackReason};
 
+use super::client::{FLOOD_BYTES_PER_S, Heard};
+
 /// Everything that can go wrong talking to the robot.
 #[derive(Debug, thiserror::Error)]
 pub enum LinkError {
@@ -63,6 +65,17 @@ pub enum LinkError {
         /// How many times it was sent.
         attempts: u32,
     },
+    /// The handshake went unanswered: what arrived instead tells a dead line (nothing), a line
+    /// held low (zeros), a loopback (echo), another device or baud rate (garbage, a flood).
+    #[error("{}", unanswered_hello(path, *attempts, heard))]
+    HelloUnanswered {
+        /// The port's path.
+        path: String,
+        /// How many times `Hello` was sent.
+        attempts: u32,
+        /// What arrived instead.
+        heard: Heard,
+    },
     /// No byte at all arrived for too long while waiting: the link is dead.
     #[error("the robot on {path} sent nothing for {secs:.1} s of wall time: link dead")]
     Silent {
@@ -117,6 +130,41 @@ pub enum LinkError {
     /// An argument the host can already tell is wrong (not finite, wrong sign).
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+}
+
+/// The message for a `Hello` that went unanswered, by what arrived instead.
+fn unanswered_hello(path: &str, attempts: u32, heard: &Heard) -> String {
+    match *heard {
+        Heard::Nothing => format!(
+            "no answer from the robot on {path}: nothing arrived while Hello was sent {attempts} \
+             times (is a robot running pushbot firmware connected, and powered?)"
+        ),
+        Heard::Zeros { bytes } => format!(
+            "only zero bytes arrive on {path} ({bytes} of them, no frame): the line is held low \
+             (a break), or a device sends at another baud rate; check the wiring (TX to RX) and \
+             that the robot runs pushbot firmware"
+        ),
+        Heard::Echo { .. } => format!(
+            "{path} echoes back what the host sends: a loopback (TX wired to RX) or a terminal \
+             that echoes, not a pushbot robot"
+        ),
+        Heard::Garbage { bytes, secs } if secs > 0.0 && bytes as f64 / secs > FLOOD_BYTES_PER_S => {
+            format!(
+                "a flood of bytes arrives on {path} ({:.0} kB/s, more than a serial line at \
+                 115 200 baud carries) and none is a pushbot frame: another device or another \
+                 program on the port, not a pushbot robot",
+                bytes as f64 / secs / 1e3
+            )
+        }
+        Heard::Garbage { bytes, secs } => format!(
+            "bytes arrive on {path} ({bytes} in {secs:.1} s) but none is a pushbot frame: wrong \
+             baud rate or another device? (or another program on the port)"
+        ),
+        Heard::Frames { frames } => format!(
+            "the robot on {path} sends pushbot frames ({frames}) but does not answer Hello \
+             after {attempts} attempts; reset the robot and try again"
+        ),
+    }
 }
 
 impl LinkError {

@@ -21,9 +21,12 @@ pub mod transport;
 
 #[cfg(test)]
 mod client_tests;
+#[cfg(test)]
+mod heard_tests;
 
 pub use client::{
-    Answer, Client, ClientOptions, Event, Handshake, HostTime, LinkStats, MotionEnd, RobotEvent,
+    Answer, Client, ClientOptions, Event, Handshake, Heard, HostTime, LinkStats, MotionEnd,
+    RobotEvent,
 };
 pub use driver::Driver;
 pub use error::{FAULT_NAMES, FaultNames, LinkError, Refusal};

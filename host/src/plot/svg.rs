@@ -238,6 +238,13 @@ impl Group {
         Group(Element::new("g"))
     }
 
+    /// An empty group with the element id `id` (for a reader or a test to find it by).
+    pub fn with_id(id: &str) -> Group {
+        let mut g = Group::new();
+        g.0.assign("id", id.to_string());
+        g
+    }
+
     /// An empty group whose shapes are moved by `(dx, dy)`.
     pub fn translated(dx: f64, dy: f64) -> Group {
         let mut g = Group::new();

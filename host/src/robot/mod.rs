@@ -130,10 +130,10 @@ impl<D: Driver> Robot<D> {
             Handshake::VersionMismatch { host, robot } => {
                 Err(LinkError::VersionMismatch { path, host, robot })
             }
-            Handshake::NoAnswer { attempts } => Err(LinkError::NoAnswer {
+            Handshake::NoAnswer { attempts, heard } => Err(LinkError::HelloUnanswered {
                 path,
-                what: "Hello",
                 attempts,
+                heard,
             }),
         }
     }

@@ -70,7 +70,10 @@ pub fn outcome_name(o: Outcome) -> String {
 pub fn link_broke(e: &LinkError) -> bool {
     matches!(
         e,
-        LinkError::NoAnswer { .. } | LinkError::Silent { .. } | LinkError::Disconnected { .. }
+        LinkError::NoAnswer { .. }
+            | LinkError::HelloUnanswered { .. }
+            | LinkError::Silent { .. }
+            | LinkError::Disconnected { .. }
     )
 }
 

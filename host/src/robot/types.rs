@@ -37,7 +37,7 @@ impl Default for LinkOptions {
         LinkOptions {
             ack_timeout: Duration::from_millis(150),
             attempts: 5,
-            hello_timeout: Duration::from_secs(2),
+            hello_timeout: Duration::from_millis(1500),
             dead_link_timeout: Duration::from_secs(3),
             watchdog_ms: 200,
             reconnect_timeout: Duration::ZERO,

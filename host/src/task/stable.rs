@@ -68,14 +68,16 @@ impl Stable {
         p.start = Pose::new(s.x, s.y, s.theta);
         p.start_contact = None;
         let plan = plan_clear(&p).filter(|pl| pl.found && !pl.steps.is_empty());
-        let plan = plan.ok_or_else(|| {
-            anyhow!(
-                "no plan of stable pushes from where the slider is ({:.3}, {:.3}, {:.0}°) to the goal",
+        let Some(plan) = plan else {
+            let why = crate::planner::stable::no_plan::why(&p, &crate::planner::stable::plan(&p))
+                .map_or_else(String::new, |w| format!(": {w}"));
+            return Err(anyhow!(
+                "no plan of stable pushes from where the slider is ({:.3}, {:.3}, {:.0}°) to the goal{why}",
                 s.x,
                 s.y,
                 s.theta.to_degrees()
-            )
-        })?;
+            ));
+        };
         Ok((p, plan))
     }
 

@@ -19,6 +19,31 @@ impl Scene {
     /// is simple and every pose finite).
     pub(super) fn check_geometry(&self) -> Result<(), Invalid> {
         use Seg::{Index, Key};
+        let fine = self
+            .obstacles
+            .iter()
+            .map(|o| ("obstacles", &o.outline))
+            .chain(self.objects.iter().map(|o| ("objects", &o.outline)))
+            .enumerate();
+        for (k, (what, outline)) in fine {
+            if outline.len() > crate::simplify::MOST_VERTICES {
+                let i = if what == "objects" {
+                    k - self.obstacles.len()
+                } else {
+                    k
+                };
+                return Err(invalid(
+                    vec![Key(what), Index(i), Key("outline")],
+                    format!(
+                        "keeps {} vertices even simplified within {:.1} mm; at most {} can be \
+                         used (export it coarser)",
+                        outline.len(),
+                        crate::simplify::OUTLINE_TOLERANCE * 1e3,
+                        crate::simplify::MOST_VERTICES
+                    ),
+                ));
+            }
+        }
         let r = &self.robot;
         if let Some(p) = r.front_plate
             && !p.valid()

@@ -301,23 +301,32 @@ impl Scene {
                 message: e.message().trim().to_owned(),
             }
         })?;
-        if let Err(bad) = scene.check() {
-            let (line, column) = match span_of(text, &bad.path) {
-                Some(s) => {
-                    let (l, c) = line_col(text, s.start);
-                    (Some(l), Some(c))
-                }
-                None => (None, None),
-            };
-            return Err(SceneError {
-                file: file.to_owned(),
-                line,
-                column,
-                field: Some(path_string(&bad.path)),
-                message: bad.message,
-            });
-        }
-        let notes = scene.normalise();
+        // The per-field checks on the scene as written (exact simple-polygon checks on every
+        // outline as given), then the normalisation (winding, fine outlines simplified), then
+        // the checks that need shapes, on the outlines every consumer will use.
+        let checked = scene.check().map(|()| scene.normalise()).and_then(|notes| {
+            scene.check_geometry()?;
+            Ok(notes)
+        });
+        let notes = match checked {
+            Ok(notes) => notes,
+            Err(bad) => {
+                let (line, column) = match span_of(text, &bad.path) {
+                    Some(s) => {
+                        let (l, c) = line_col(text, s.start);
+                        (Some(l), Some(c))
+                    }
+                    None => (None, None),
+                };
+                return Err(SceneError {
+                    file: file.to_owned(),
+                    line,
+                    column,
+                    field: Some(path_string(&bad.path)),
+                    message: bad.message,
+                });
+            }
+        };
         if let Some(IntrinsicsSpec::Inline(l)) = &scene.camera.intrinsics {
             scene.camera.lens = Some(l.for_size(scene.camera.width, scene.camera.height));
         }

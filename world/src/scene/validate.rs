@@ -4,6 +4,7 @@
 
 use super::error::{Invalid, Seg, invalid, path_string};
 use super::{Marker, Note, Scene, Support, placed, pose_finite};
+use crate::simplify::{FINE_OUTLINE, OUTLINE_TOLERANCE, Simplified, simplify};
 
 impl Scene {
     pub(super) fn check(&self) -> Result<(), Invalid> {
@@ -144,14 +145,65 @@ impl Scene {
             }
         }
         self.check_sections()?;
-        self.check_perturb()?;
-        self.check_geometry()
+        self.check_perturb()
     }
 
     /// Store every outline counter-clockwise (reversed keeping vertex 0 first, so the shape is
-    /// the same); the stable task's edge numbers follow its object's outline. Returns what was
-    /// changed.
+    /// the same) and simplify every outline of more than [`FINE_OUTLINE`] vertices within
+    /// [`OUTLINE_TOLERANCE`]; the stable task's edge numbers follow its object's outline.
+    /// Returns what was changed.
     pub(super) fn normalise(&mut self) -> Vec<Note> {
+        let mut notes = self.normalise_winding();
+        notes.extend(self.simplify_fine_outlines());
+        notes
+    }
+
+    fn simplify_fine_outlines(&mut self) -> Vec<Note> {
+        let note = |field: String, n: usize, s: &Simplified, extra: &str| Note {
+            field,
+            message: format!(
+                "has {n} vertices; simplified to {} within {:.3} mm{extra}",
+                s.outline.len(),
+                s.tolerance * 1e3
+            ),
+        };
+        let mut notes = Vec::new();
+        for (i, o) in self.obstacles.iter_mut().enumerate() {
+            let n = o.outline.len();
+            if n > FINE_OUTLINE
+                && let Some(s) = simplify(&o.outline, OUTLINE_TOLERANCE)
+            {
+                notes.push(note(format!("obstacles[{i}].outline"), n, &s, ""));
+                o.outline = s.outline;
+            }
+        }
+        for (i, o) in self.objects.iter_mut().enumerate() {
+            let n = o.outline.len();
+            if n <= FINE_OUTLINE {
+                continue;
+            }
+            let Some(s) = simplify(&o.outline, OUTLINE_TOLERANCE) else {
+                continue;
+            };
+            let mut extra = "";
+            if let Some(st) = self.stable.as_mut().filter(|st| st.object == o.id) {
+                let mut edges: Vec<usize> = Vec::with_capacity(st.edges.len());
+                for e in st.edges.iter().map(|e| s.edge_of(*e)) {
+                    if !edges.contains(&e) {
+                        edges.push(e);
+                    }
+                }
+                st.edges = edges;
+                st.start_edge = st.start_edge.map(|e| s.edge_of(e));
+                extra = " (stable.edges renumbered to the simplified edges that hold them)";
+            }
+            notes.push(note(format!("objects[{i}].outline"), n, &s, extra));
+            o.outline = s.outline;
+        }
+        notes
+    }
+
+    fn normalise_winding(&mut self) -> Vec<Note> {
         use crate::polygon::{normalise_ccw, reversed_edge};
         let note = |field: String, extra: &str| Note {
             field,

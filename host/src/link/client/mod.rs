@@ -48,7 +48,7 @@ mod types;
 mod wire;
 
 pub use types::{
-    Answer, ClientOptions, Event, Handshake, HostTime, LinkStats, MotionEnd, RobotEvent,
+    Answer, ClientOptions, Event, Handshake, Heard, HostTime, LinkStats, MotionEnd, RobotEvent,
 };
 use wire::{Incoming, Reader};
 
@@ -60,6 +60,20 @@ const RECENT_DONES: usize = 16;
 const HELLO_ROUNDS: u32 = 3;
 /// How long a rejected frame or a telemetry gap marks the wire as noisy, host time.
 pub const NOISY_FOR: Duration = Duration::from_secs(5);
+/// How many of its latest frames the host remembers, to recognise them coming back (echo).
+const ECHO_FRAMES: usize = 8;
+/// A flood: more bytes per second than a serial line at 115 200 baud can carry.
+pub const FLOOD_BYTES_PER_S: f64 = 11_520.0;
+
+/// What arrived since the handshake began (see [`Heard`]).
+#[derive(Debug, Clone, Copy, Default)]
+struct Listened {
+    since: HostTime,
+    bytes: u64,
+    zeros: u64,
+    echoes: u64,
+    frames: u64,
+}
 
 /// A command sent and not yet answered.
 #[derive(Debug, Clone, Copy)]
@@ -114,6 +128,11 @@ pub struct Client {
     noisy_until: Option<HostTime>,
     /// The shortest step between telemetries seen, µs of robot time (the robot's period).
     telemetry_step_us: Option<u64>,
+    /// What arrived since the latest `Hello`.
+    listened: Listened,
+    /// The latest frames sent (without delimiters), kept until a robot frame arrives: an echo
+    /// of them is not the robot talking.
+    sent_frames: VecDeque<Vec<u8>>,
 }
 
 /// Whether a heartbeat is due: a quarter watchdog period of robot time since the last frame
@@ -161,6 +180,11 @@ impl Client {
             dead_reported: false,
             noisy_until: None,
             telemetry_step_us: None,
+            listened: Listened {
+                since: now,
+                ..Listened::default()
+            },
+            sent_frames: VecDeque::new(),
             opts,
         }
     }
@@ -186,6 +210,10 @@ impl Client {
     /// [`Client::handshake`] (and an event).
     pub fn hello(&mut self, now: HostTime) -> u16 {
         self.handshake = None;
+        self.listened = Listened {
+            since: now,
+            ..Listened::default()
+        };
         self.hello_round(now, 0)
     }
 
@@ -248,7 +276,16 @@ impl Client {
 
     fn send_frame(&mut self, now: HostTime, frame: &HostFrame) {
         match wire::encode(frame) {
-            Ok(bytes) => self.transmits.push_back(bytes),
+            Ok(bytes) => {
+                if self.stats.frames_ok == 0 {
+                    if self.sent_frames.len() >= ECHO_FRAMES {
+                        self.sent_frames.pop_front();
+                    }
+                    self.sent_frames
+                        .push_back(bytes.iter().copied().filter(|&b| b != 0).collect());
+                }
+                self.transmits.push_back(bytes);
+            }
             Err(e) => {
                 tracing::error!("cannot frame {:?}: {e}", frame.cmd);
                 return;
@@ -300,11 +337,20 @@ impl Client {
             self.last_rx = now;
             self.dead_reported = false;
             self.stats.bytes_received += bytes.len() as u64;
+            self.listened.bytes += bytes.len() as u64;
+            self.listened.zeros += bytes.iter().filter(|&&b| b == 0).count() as u64;
         }
         for &b in bytes {
-            match self.reader.push(b) {
+            let incoming = self.reader.push(b);
+            if b == 0 && incoming.is_some() && self.is_echo() {
+                self.listened.echoes += 1;
+                continue;
+            }
+            match incoming {
                 None => {}
                 Some(Incoming::Msg(msg)) => {
+                    self.listened.frames += 1;
+                    self.sent_frames.clear();
                     self.stats.frames_ok += 1;
                     self.handle_msg(now, msg);
                 }
@@ -337,7 +383,10 @@ impl Client {
                 i += 1;
                 continue;
             }
-            if p.sent < p.max || (self.noisy(now) && p.sent < 2 * p.max) {
+            // A noisy wire earns more attempts only once the robot was heard: a line that
+            // never carried one pushbot frame is not a robot on a bad wire.
+            let noisy = self.noisy(now) && self.stats.frames_ok > 0;
+            if p.sent < p.max || (noisy && p.sent < 2 * p.max) {
                 tracing::debug!("no answer to {:?} #{}; resending", p.frame.cmd, p.frame.seq);
                 self.stats.retries += 1;
                 self.send_frame(now, &p.frame);
@@ -353,7 +402,11 @@ impl Client {
                 attempts: p.sent,
             });
             if self.hello.is_some_and(|h| h.seq == seq) {
-                self.finish_hello(Handshake::NoAnswer { attempts: p.sent });
+                let heard = self.heard(now);
+                self.finish_hello(Handshake::NoAnswer {
+                    attempts: p.sent,
+                    heard,
+                });
             } else {
                 self.watched.retain(|w| w.seq != seq);
                 self.answer(seq, Answer::GaveUp { attempts: p.sent });
@@ -365,6 +418,31 @@ impl Client {
         {
             self.dead_reported = true;
             self.events.push_back(Event::LinkDead { silent });
+        }
+    }
+
+    /// Whether the frame the reader just completed is one of the host's own, come back.
+    fn is_echo(&self) -> bool {
+        let frame = self.reader.last_frame();
+        !frame.is_empty() && self.sent_frames.iter().any(|s| s.as_slice() == frame)
+    }
+
+    /// What arrived since the latest `Hello`, at `now`.
+    fn heard(&self, now: HostTime) -> Heard {
+        let l = self.listened;
+        if l.bytes == 0 {
+            Heard::Nothing
+        } else if l.frames > 0 {
+            Heard::Frames { frames: l.frames }
+        } else if l.echoes > 0 {
+            Heard::Echo { bytes: l.bytes }
+        } else if l.zeros == l.bytes {
+            Heard::Zeros { bytes: l.bytes }
+        } else {
+            Heard::Garbage {
+                bytes: l.bytes,
+                secs: now.since(l.since).as_secs_f64(),
+            }
         }
     }
 
@@ -435,8 +513,10 @@ impl Client {
                 .iter()
                 .find(|p| p.frame.seq == h.seq)
                 .map_or(0, |p| p.sent);
+            let heard = self.heard(now);
             self.finish_hello(Handshake::NoAnswer {
                 attempts: attempts.max(self.hello_attempts()),
+                heard,
             });
         }
     }

@@ -58,7 +58,7 @@ impl Default for ClientOptions {
         ClientOptions {
             ack_timeout: Duration::from_millis(150),
             attempts: 5,
-            hello_timeout: Duration::from_secs(2),
+            hello_timeout: Duration::from_millis(1500),
             dead_link_timeout: Duration::from_secs(3),
             watchdog_ms: 200,
             protocol_version: PROTOCOL_VERSION,
@@ -212,6 +212,39 @@ pub enum Handshake {
     NoAnswer {
         /// How many times `Hello` was sent in the last round.
         attempts: u32,
+        /// What arrived instead, while the host waited.
+        heard: Heard,
+    },
+}
+
+/// What arrived on the line while a `Hello` went unanswered: what tells a dead line from one
+/// that talks, but not pushbot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Heard {
+    /// Not one byte.
+    Nothing,
+    /// Only zero bytes: a line held low (a break), or a device sending at another baud rate.
+    Zeros {
+        /// How many.
+        bytes: u64,
+    },
+    /// The host's own frames came back: a loopback, or a terminal echoing what it is sent.
+    Echo {
+        /// How many bytes arrived in all.
+        bytes: u64,
+    },
+    /// Bytes of which no frame was a pushbot frame: a wrong baud rate, another device, another
+    /// program on the port.
+    Garbage {
+        /// How many bytes arrived.
+        bytes: u64,
+        /// Over how long, s of host time.
+        secs: f64,
+    },
+    /// Valid pushbot frames, but no reply to `Hello`.
+    Frames {
+        /// How many frames.
+        frames: u64,
     },
 }
 

@@ -24,6 +24,8 @@ pub(crate) struct Reader {
     decoder: FrameDecoder,
     /// The current frame's raw bytes, to read the version of a reply we cannot decode.
     raw: Vec<u8>,
+    /// The raw bytes of the latest completed frame (delimiter excluded).
+    last: Vec<u8>,
 }
 
 impl Reader {
@@ -32,6 +34,7 @@ impl Reader {
         Reader {
             decoder: FrameDecoder::new(),
             raw: Vec::with_capacity(MAX_FRAME),
+            last: Vec::with_capacity(MAX_FRAME),
         }
     }
 
@@ -41,18 +44,18 @@ impl Reader {
             self.raw.push(b);
         }
         let result = self.decoder.push::<RobotMsg>(b);
-        let frame = if b == 0 {
-            std::mem::take(&mut self.raw)
-        } else {
-            Vec::new()
-        };
+        if b == 0 {
+            std::mem::swap(&mut self.last, &mut self.raw);
+            self.raw.clear();
+        }
+        let frame = &self.last;
         match result? {
             Ok(msg) => Some(Incoming::Msg(msg)),
             Err(error) => {
                 // CRC good but not a message of ours: another protocol version?
                 let foreign_hello =
                     if matches!(error, DecodeError::Message | DecodeError::TrailingBytes) {
-                        frame_payload(&frame).and_then(|p| peek_hello_version(&p))
+                        frame_payload(frame).and_then(|p| peek_hello_version(&p))
                     } else {
                         None
                     };
@@ -62,6 +65,11 @@ impl Reader {
                 })
             }
         }
+    }
+
+    /// The raw (COBS-encoded) bytes of the latest frame completed, delimiter excluded.
+    pub fn last_frame(&self) -> &[u8] {
+        &self.last
     }
 }
 

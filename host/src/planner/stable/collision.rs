@@ -229,6 +229,9 @@ pub struct World {
     pub obstacles: Vec<Obstacle>,
     /// How many leading entries of `obstacles` are walls.
     pub n_walls: usize,
+    /// What each entry of `obstacles` is, as the scene names it (`obstacles[2]`, `object box`,
+    /// `the left wall`): the parts of one scene obstacle share its name.
+    pub names: Vec<String>,
 }
 
 impl World {
@@ -250,12 +253,54 @@ impl World {
             rect(-t, 0.0, 0.0, h),
             rect(w, 0.0, w + t, h),
         ];
+        let mut names: Vec<String> = [
+            "the table's bottom edge (y = 0)",
+            "the table's top edge",
+            "the table's left edge (x = 0)",
+            "the table's right edge",
+        ]
+        .map(String::from)
+        .to_vec();
+        names.extend((0..obstacles.len()).map(|i| format!("obstacle part {i}")));
         all.extend(obstacles);
         World {
             table: (w, h),
             obstacles: all,
             n_walls: 4,
+            names,
         }
+    }
+
+    /// This world with only the obstacles (walls among them) whose index `keep` accepts.
+    pub fn only(&self, keep: impl Fn(usize) -> bool) -> World {
+        let (mut obstacles, mut names) = (Vec::new(), Vec::new());
+        let mut n_walls = 0;
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if keep(i) {
+                obstacles.push(o.clone());
+                names.push(self.names[i].clone());
+                n_walls += usize::from(i < self.n_walls);
+            }
+        }
+        World {
+            table: self.table,
+            obstacles,
+            n_walls,
+            names,
+        }
+    }
+
+    /// The distinct names of the obstacles `indices`, in order of first appearance.
+    pub fn names_of(&self, indices: impl IntoIterator<Item = usize>) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for i in indices {
+            if let Some(n) = self.names.get(i)
+                && !out.contains(n)
+            {
+                out.push(n.clone());
+            }
+        }
+        out
     }
 }
 

@@ -11,6 +11,7 @@
 
 pub mod collision;
 pub mod exact;
+pub mod no_plan;
 pub mod presets;
 pub mod pusher;
 pub mod random_scene;

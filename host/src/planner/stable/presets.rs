@@ -173,7 +173,9 @@ pub fn scene_from_toml(text: &str, file: &str) -> anyhow::Result<Scene> {
     let object = shared.objects.iter().position(|o| o.id == s.task.object);
     s.outline_reversed = object.is_some_and(|i| {
         let field = format!("objects[{i}].outline");
-        notes.iter().any(|n| n.field == field)
+        notes
+            .iter()
+            .any(|n| n.field == field && n.message.contains("clockwise"))
     });
     Ok(s)
 }
@@ -522,11 +524,12 @@ impl Scene {
             weight: 1.0,
         };
         let mut obstacles = Vec::new();
+        let mut names = Vec::new();
         for (i, o) in self.obstacles.iter().enumerate() {
-            obstacles.extend(
-                Obstacle::parts(&pts(&o.polygon))
-                    .ok_or_else(|| anyhow!("obstacles[{i}]: degenerate or not simple"))?,
-            );
+            let parts = Obstacle::parts(&pts(&o.polygon))
+                .ok_or_else(|| anyhow!("obstacles[{i}]: degenerate or not simple"))?;
+            names.extend(std::iter::repeat_n(format!("obstacles[{i}]"), parts.len()));
+            obstacles.extend(parts);
         }
         for o in &self.objects {
             if o.id == self.task.object {
@@ -536,12 +539,18 @@ impl Scene {
                 let s = self.slider(&o.id)?;
                 let q = Pose::new(pose[0], pose[1], pose[2].to_radians());
                 let w: Vec<V2> = s.vertices.iter().map(|v| q.apply(*v)).collect();
-                obstacles.extend(
-                    Obstacle::parts(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?,
-                );
+                let parts =
+                    Obstacle::parts(&w).ok_or_else(|| anyhow!("objects[{}]: degenerate", o.id))?;
+                names.extend(std::iter::repeat_n(
+                    format!("object {:?}", o.id),
+                    parts.len(),
+                ));
+                obstacles.extend(parts);
             }
         }
-        let world = World::new(self.table[0], self.table[1], obstacles);
+        let mut world = World::new(self.table[0], self.table[1], obstacles);
+        world.names.truncate(world.n_walls);
+        world.names.extend(names);
         let t = &self.task;
         let start = Pose::new(t.start[0], t.start[1], t.start[2].to_radians());
         let goal = Pose::new(t.goal[0], t.goal[1], t.goal[2].to_radians());

@@ -46,6 +46,14 @@ pub struct Pusher {
 }
 
 impl Pusher {
+    /// A car's minimum turning radius, m; `None` for other kinds.
+    pub fn min_turning_radius(&self) -> Option<f64> {
+        match self.kind {
+            PusherKind::Car { min_turning_radius } => Some(min_turning_radius),
+            _ => None,
+        }
+    }
+
     /// A pusher of negligible extent, as the robot arm of §4.4.
     pub fn arm() -> Self {
         Pusher {

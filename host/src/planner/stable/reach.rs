@@ -27,15 +27,26 @@ pub struct Unreachable {
     pub radius: f64,
     /// Cells of the start's component.
     pub component_cells: usize,
+    /// The obstacles (indices into the world's) that bound the start's component: together
+    /// they cut the start off from the goal.
+    pub blockers: Vec<usize>,
+    /// Their names, as the scene gives them.
+    pub names: Vec<String>,
 }
 
 impl fmt::Display for Unreachable {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let who = match self.names.as_slice() {
+            [] => "obstacles and walls".to_string(),
+            [one] => one.clone(),
+            [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+        };
         write!(
             f,
-            "the goal is unreachable from the start: obstacles and walls separate them (the \
-             slider's centre of friction, with the {:.1} mm disk about it that lies inside the \
-             slider, cannot get from its start to the goal neighbourhood; {} grid cells reached)",
+            "the goal is unreachable from the start: {who} cut the start off from the goal \
+             (the slider's centre of friction, with the {:.1} mm disk about it that lies inside \
+             the slider, cannot get from its start to the goal neighbourhood; {} grid cells \
+             reached)",
             self.radius * 1e3,
             self.component_cells
         )
@@ -77,20 +88,28 @@ pub fn unreachable(p: &Problem) -> Option<Unreachable> {
     }
     let (nx, ny) = ((w / s).ceil() as usize, (h / s).ceil() as usize);
     let centre = |i: usize, j: usize| V2::new((i as f64 + 0.5) * s, (j as f64 + 0.5) * s);
-    let blocked = |c: V2| {
-        if c.x.min(w - c.x).min(c.y).min(h - c.y) < margin {
-            return true;
+    // The obstacle that blocks the cell centred at `c` (walls by their index in the world).
+    let blocker = |c: V2| -> Option<usize> {
+        let walls = [c.y, h - c.y, c.x, w - c.x];
+        // The world's first four obstacles are the walls, in this order (`World::new`).
+        if let Some(i) = walls.iter().position(|&d| d < margin) {
+            return Some(i);
         }
-        p.world.obstacles[p.world.n_walls..].iter().any(|o| {
-            let b = o.bounds;
-            let dx = (b[0] - c.x).max(c.x - b[2]).max(0.0);
-            let dy = (b[1] - c.y).max(c.y - b[3]).max(0.0);
-            dx * dx + dy * dy < margin * margin
-                && o.shape()
-                    .distance_to_point(&PPose::identity(), PVec::new(c.x, c.y), true)
-                    < margin
-        })
+        let n = p.world.n_walls;
+        p.world.obstacles[n..]
+            .iter()
+            .position(|o| {
+                let b = o.bounds;
+                let dx = (b[0] - c.x).max(c.x - b[2]).max(0.0);
+                let dy = (b[1] - c.y).max(c.y - b[3]).max(0.0);
+                dx * dx + dy * dy < margin * margin
+                    && o.shape()
+                        .distance_to_point(&PPose::identity(), PVec::new(c.x, c.y), true)
+                        < margin
+            })
+            .map(|i| n + i)
     };
+    let mut blockers: Vec<usize> = Vec::new();
     let cell = |x: f64, y: f64| {
         let i = ((x / s).floor().max(0.0) as usize).min(nx - 1);
         let j = ((y / s).floor().max(0.0) as usize).min(ny - 1);
@@ -126,14 +145,19 @@ pub fn unreachable(p: &Problem) -> Option<Unreachable> {
             let (a, b) = (a as usize, b as usize);
             if !seen[b * nx + a] {
                 seen[b * nx + a] = true;
-                if !blocked(centre(a, b)) {
-                    stack.push((a, b));
+                match blocker(centre(a, b)) {
+                    None => stack.push((a, b)),
+                    Some(o) if !blockers.contains(&o) => blockers.push(o),
+                    Some(_) => {}
                 }
             }
         }
     }
+    blockers.sort_unstable();
     Some(Unreachable {
         radius: r,
         component_cells: count,
+        names: p.world.names_of(blockers.iter().copied()),
+        blockers,
     })
 }

@@ -1,10 +1,12 @@
 //! SVG drawings of stable pushing plans in the manner of Lynch & Mason (1996) Figs. 13–18:
 //! obstacles, the slider drawn along its path, the pusher at the start and at each contact
-//! change, the goal, and (beyond the paper) the pusher's transit paths.
+//! change, the goal, and (beyond the paper) the pusher's transit paths; for a search that found
+//! no plan, the tree it explored (group `explored`: one line per expanded configuration, from
+//! its parent's centre to its own).
 
 use super::{Plan, Pose, Problem};
 use crate::mechanics::V2;
-use crate::plot::svg::{Doc, Draw, Frame, Style};
+use crate::plot::svg::{Doc, Draw, Frame, Group, Style};
 
 /// The longer table side in user units.
 const SIDE: f64 = 600.0;
@@ -47,6 +49,17 @@ pub fn render_executed(p: &Problem, plan: Option<&Plan>, executed: &[[f64; 2]]) 
     let Some(plan) = plan else {
         return d.to_string();
     };
+    if !plan.found && !plan.search.tree.is_empty() {
+        let mut g = Group::with_id("explored");
+        let style = Style::outline("#7a9", 0.6).opacity(0.7);
+        for [a, b] in &plan.search.tree {
+            g.line(f.map([a.x, a.y]), f.map([b.x, b.y]), &style);
+        }
+        d.group(g);
+        if let Some((q, _)) = plan.search.closest {
+            d.polygon(&slider(&q), &Style::outline("#c60", 1.5));
+        }
+    }
     let every = (plan.steps.len() / 40).max(1);
     let mut prev_contact = None;
     for (i, st) in plan.steps.iter().enumerate() {

@@ -11,7 +11,9 @@ use super::crossing::goal_finish;
 use super::finish::pushes_in_steps;
 use super::grid::{Cells, Grid, GridHasher};
 use super::open::{Fifo, Finish, Open, Pending, Queue};
-use super::steps::{Plan, Step, step_cost, summarise};
+use super::steps::{
+    Plan, SearchEnd, SearchTrace, Step, TREE_EDGES, goal_measure, step_cost, summarise,
+};
 use crate::planner::stable::collision::Frame;
 use crate::planner::stable::reach::unreachable;
 use crate::planner::stable::transit::{TransitPath, Transits};
@@ -170,9 +172,14 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             steps: vec![],
             transits: vec![],
             exact_goal: false,
+            search: SearchTrace {
+                ended: SearchEnd::Unreachable,
+                ..SearchTrace::default()
+            },
         };
     }
     let heur = Heuristic::new(p);
+    let mut trace = SearchTrace::default();
     // Expanded nodes (the goal last): parents of what is in OPEN, and the plan's chain.
     let mut closed: Vec<Expanded> = Vec::with_capacity(p.params.max_nodes.min(1 << 20) + 1);
     let mut transits: Vec<TransitPath> = Vec::new();
@@ -232,7 +239,10 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                     n.contact,
                 ) {
                     Some(ti) => transit_id = ti,
-                    None => continue,
+                    None => {
+                        trace.no_transit += 1;
+                        continue;
+                    }
                 }
             }
             closed.push(Expanded {
@@ -279,7 +289,10 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                     n.contact,
                 ) {
                     Some(ti) => transit_id = ti,
-                    None => continue,
+                    None => {
+                        trace.no_transit += 1;
+                        continue;
+                    }
                 }
             }
             closed.push(Expanded {
@@ -326,6 +339,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 n.control as usize,
                 &q,
             ) {
+                trace.collided += 1;
                 continue;
             }
         }
@@ -343,7 +357,10 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                     n.contact,
                 ) {
                     Some(ti) => transit_id = ti,
-                    None => continue,
+                    None => {
+                        trace.no_transit += 1;
+                        continue;
+                    }
                 }
             }
         }
@@ -370,9 +387,14 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
             occupied.set(key, n.cost);
         }
         if expanded >= p.params.max_nodes {
+            trace.ended = SearchEnd::NodeLimit;
             break;
         }
         expanded += 1;
+        let m = goal_measure(p, &q);
+        if trace.closest.is_none_or(|(_, best)| m < best) {
+            trace.closest = Some((q, m));
+        }
         let prev = (n.contact != NONE).then_some((
             n.contact as usize,
             if n.control == NONE {
@@ -404,6 +426,7 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 };
                 let cost = n.cost.saturating_add(dc);
                 if cost > max_cost {
+                    trace.cut_by_cost += 1;
                     continue;
                 }
                 let q2 = q.compose(delta, sc);
@@ -420,10 +443,12 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
                 // The curve of control `k` through `q2` is the one through `q`.
                 let h = h.saturating_add(heur.turn_cost(&q, sc, ci, k));
                 if cost.saturating_add(h) > max_cost {
+                    trace.cut_by_cost += 1;
                     continue;
                 }
                 let f = weighted(cost, h, weight, max_cost);
                 if !lazy && !step_ok(p, &q, (sc, fine), ci, k, &q2) {
+                    trace.collided += 1;
                     continue;
                 }
                 open.push(
@@ -506,7 +531,18 @@ pub fn plan_checked(p: &Problem, queue: Queue, checks: Checks) -> Plan {
         steps: vec![],
         transits: vec![],
         exact_goal: false,
+        search: trace,
     };
+    if goal_node.is_some() {
+        plan.search.ended = SearchEnd::Goal;
+    } else {
+        plan.search.tree = closed
+            .iter()
+            .filter(|n| n.parent != NONE)
+            .take(TREE_EDGES)
+            .map(|n| [closed[n.parent as usize].q, n.q])
+            .collect();
+    }
     if let Some(g) = goal_node {
         let mut chain = Vec::new();
         let mut i = g;

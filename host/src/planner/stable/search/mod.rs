@@ -32,4 +32,7 @@ pub use crossing::{goal_crossing, goal_finish};
 pub use finish::exact_goal;
 pub(super) use finish::{backed_up, push_steps};
 pub use open::Queue;
-pub use steps::{Plan, Step, step_cost, step_twist_of, summarise};
+pub use steps::{
+    Plan, SearchEnd, SearchTrace, Step, TREE_EDGES, goal_measure, step_cost, step_twist_of,
+    summarise,
+};

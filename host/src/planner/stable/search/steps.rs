@@ -48,6 +48,55 @@ pub struct Plan {
     pub transits: Vec<TransitPath>,
     /// Whether the plan ends exactly at the goal (§4.5 variant).
     pub exact_goal: bool,
+    /// How the search ended and what it saw (for saying why there is no plan).
+    #[serde(skip)]
+    pub search: SearchTrace,
+}
+
+/// How a search ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SearchEnd {
+    /// It reached the goal neighbourhood.
+    Goal,
+    /// It expanded `max_nodes` configurations.
+    NodeLimit,
+    /// OPEN ran empty: every configuration the grid and the costs let it reach was expanded.
+    #[default]
+    Exhausted,
+    /// It did not start: the goal is cut off from the start ([`crate::planner::stable::reach`]).
+    Unreachable,
+}
+
+/// Most edges of the explored tree a failed search keeps (for drawing it).
+pub const TREE_EDGES: usize = 20_000;
+
+/// What a search saw: how it ended, what it dropped and why, how close it came.
+#[derive(Debug, Clone, Default)]
+pub struct SearchTrace {
+    /// How it ended.
+    pub ended: SearchEnd,
+    /// Steps dropped because their cost (with the bound) passed `max_cost`.
+    pub cut_by_cost: u64,
+    /// Steps dropped because they collide.
+    pub collided: u64,
+    /// Contact changes dropped because the pusher found no transit path to the new contact.
+    pub no_transit: u64,
+    /// The expanded configuration nearest the goal (by the larger of its distance and angle
+    /// over the goal neighbourhood's), and that measure (1 is the neighbourhood's edge).
+    pub closest: Option<(Pose, f64)>,
+    /// Edges `(parent, child)` of the explored tree, at most [`TREE_EDGES`], when no plan was
+    /// found.
+    pub tree: Vec<[Pose; 2]>,
+}
+
+/// How far `q` is from the goal neighbourhood of `p`: the largest of its offsets in x and y
+/// over the neighbourhood's half-width and its angle over the neighbourhood's half-angle (at
+/// most 1 inside the neighbourhood, as [`Problem::in_goal`] decides).
+pub fn goal_measure(p: &Problem, q: &Pose) -> f64 {
+    let d = (q.x - p.goal.x).abs().max((q.y - p.goal.y).abs()) / p.params.goal_xy.max(1e-12);
+    let a = crate::planner::stable::angle_diff(q.theta, p.goal.theta).abs()
+        / p.params.goal_theta.max(1e-12);
+    d.max(a)
 }
 
 /// Cost of a step given the previous step's (contact, control).
