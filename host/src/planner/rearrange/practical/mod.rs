@@ -25,7 +25,7 @@ use std::time::Instant;
 
 pub use leg::{Action, Leg, Move};
 
-use super::problem::{Config, Dir, Model, Placement, Problem, ProblemError};
+use super::problem::{Config, Dir, Placement, Problem, ProblemError};
 
 /// How hard the object-level search tries.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -195,7 +195,13 @@ fn search(
         let unplaced: Vec<usize> = (0..r)
             .filter(|&i| p.goal_movables[i].is_some_and(|g| config.movables[i] != g))
             .collect();
-        if unplaced.is_empty() {
+        // A movable on a cell where none may be left must be the one pushed next (§IV-B: after
+        // every move, each movable not pushed lies where it may be left).
+        let unleavable: Vec<usize> = (0..r)
+            .filter(|&j| !may_leave(p, j, config.movables[j]))
+            .collect();
+        let may_push = |i: Option<usize>| unleavable.iter().all(|&j| Some(j) == i);
+        if unplaced.is_empty() && may_push(None) {
             let want = leg::Wanted {
                 target: None,
                 robot_target: p.goal_robot,
@@ -210,7 +216,7 @@ fn search(
         // movable still to be placed, or anywhere when some movable has no direct leg.
         let mut stuck = false;
         let mut direct: Vec<Leg> = Vec::new();
-        for &i in &unplaced {
+        for &i in unplaced.iter().filter(|&&i| may_push(Some(i))) {
             let want = leg::Wanted {
                 target: p.goal_movables[i],
                 robot_target: None,
@@ -230,7 +236,7 @@ fn search(
                 i != j
                     && p.goal_movables[i].is_some_and(|g| overlaps(p, j, config.movables[j], i, g))
             });
-            if !(on_goal || stuck || wide) {
+            if !(on_goal || stuck || wide) || !may_push(Some(j)) {
                 continue;
             }
             // A parked movable must not cover the goal of another movable still to be placed.
@@ -282,7 +288,7 @@ fn normalize(p: &Problem, c: &mut Config) {
 /// error if it cannot reach its goal even alone there (then no plan exists).
 fn cheapest_push_or_proof(p: &Problem, i: usize, proves: bool) -> Result<u32, PracticalError> {
     let bare = leg::sub_problem(p, &p.start, Some(i), true);
-    let model = Model::new(&bare)?;
+    let model = leg::leg_model(p, &bare)?;
     let robot_min = model.robot_cost.iter().copied().min().unwrap_or(1);
     let push_min = model.push_cost[0].iter().copied().min().unwrap_or(0);
     if proves
@@ -316,6 +322,14 @@ fn overlaps(p: &Problem, j: usize, a: Placement, i: usize, b: Placement) -> bool
         .cells_at(b.o)
         .iter()
         .any(|&(x, y)| cj.contains(&(b.x + x, b.y + y)))
+}
+
+/// May movable `j` be left at `pl` (no cell of it where movables may not be left)?
+fn may_leave(p: &Problem, j: usize, pl: Placement) -> bool {
+    p.movables[j]
+        .cells_at(pl.o)
+        .iter()
+        .all(|&(x, y)| p.grid.get(pl.x + x, pl.y + y).is_none_or(|c| !c.no_leave))
 }
 
 /// Mark the cells movable `j` covers at `pl`.
