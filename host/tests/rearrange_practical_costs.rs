@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use pushbot::planner::rearrange::admissibility::MoveKind;
 use pushbot::planner::rearrange::practical::{
-    Action, Options, PracticalError, PracticalPlan, plan_practical,
+    Action, GaveUp, Options, PracticalError, PracticalPlan, plan_practical,
 };
 use pushbot::planner::rearrange::problem::face_modes;
 use pushbot::planner::rearrange::{
@@ -225,8 +225,8 @@ fn replay(p: &Problem, model: &Model, plan: &PracticalPlan) -> Result<Vec<Mismat
             .find(|s| s.dir == m.dir && same_kind(s.kind) && arrives(s.to))
             .ok_or_else(|| {
                 format!(
-                    "step {k} ({:?} {:?} to {:?}) is not an admissible move of the problem",
-                    m.action, m.dir, m.config
+                    "step {k} ({:?} {:?} to {:?}) is not an admissible move of the problem DBG {:?} noleave {:?}",
+                    m.action, m.dir, m.config, p.rules, m.config.movables.iter().map(|pl| p.grid.get(pl.x, pl.y).map(|c| c.no_leave)).collect::<Vec<_>>()
                 )
             })?;
         if step.cost != m.cost {
@@ -259,6 +259,9 @@ fn replay(p: &Problem, model: &Model, plan: &PracticalPlan) -> Result<Vec<Mismat
 /// packed configurations.
 const EXACT_UP_TO: u64 = 300_000;
 
+/// The exact map that checks a "several at once" reason is built up to this many configurations.
+const ONE_AT_A_TIME_UP_TO: u64 = 40_000_000;
+
 #[test]
 fn every_practical_step_costs_what_the_metric_charges() {
     let t0 = Instant::now();
@@ -267,6 +270,7 @@ fn every_practical_step_costs_what_the_metric_charges() {
     let mut by_movables = [0usize; 5];
     let mut bad: Vec<String> = Vec::new();
     let (mut mismatched_plans, mut mismatched_steps, mut missed) = (0, 0, 0);
+    let (mut budget, mut several, mut several_confirmed) = (0, 0, 0);
     while plans < 500 {
         instances += 1;
         assert!(instances < 5_000, "too few instances were generated");
@@ -276,10 +280,7 @@ fn every_practical_step_costs_what_the_metric_charges() {
         };
         p.name = format!("instance {instances} ({n} movables)");
         let model = Model::new(&p).expect("the generator checks the problem");
-        let tp = Instant::now();
         let result = plan_practical(&p, &Options::for_problem(&p));
-        let dp = tp.elapsed().as_secs_f64();
-        if dp > 0.1 { eprintln!("DBG {} practical {dp:.2}s ok={} n={} {:?}", p.name, result.is_ok(), model.n_states, result.as_ref().err()); }
         match result {
             Ok(plan) => {
                 plans += 1;
@@ -290,7 +291,16 @@ fn every_practical_step_costs_what_the_metric_charges() {
                     Ok(mm) if !mm.is_empty() => {
                         mismatched_plans += 1;
                         mismatched_steps += mm.len();
-                        bad.push(format!("{}: {mm:?} under {:?}", p.name, p.metric));
+                        let steps: Vec<String> = mm
+                            .iter()
+                            .map(|m| {
+                                format!(
+                                    "step {} {:?} costs {} in the plan, {} under the metric",
+                                    m.step, m.action, m.plan, m.metric
+                                )
+                            })
+                            .collect();
+                        bad.push(format!("{}: {} ({:?})", p.name, steps.join("; "), p.metric));
                     }
                     Ok(_) => {}
                 }
@@ -303,21 +313,69 @@ fn every_practical_step_costs_what_the_metric_charges() {
                     }
                 }
             }
-            // The goals are where a walk of admissible moves ended: a plan exists.
-            Err(e) => {
+            // The goals are where a walk of admissible moves ended: a plan exists, so the
+            // search must say why it gave up, and the reason must hold.
+            Err(PracticalError::NoPlanFound { expansions, why }) => {
                 missed += 1;
-                bad.push(format!("{}: a plan exists, but: {e}", p.name));
+                match why {
+                    GaveUp::Budget { limit } => {
+                        budget += 1;
+                        if limit != Options::for_problem(&p).max_expansions || expansions < limit {
+                            bad.push(format!(
+                                "{}: 'budget spent' after {expansions} nodes of {limit}",
+                                p.name
+                            ));
+                        }
+                    }
+                    GaveUp::Exhausted {
+                        several_at_once, ..
+                    } => {
+                        several += 1;
+                        if !several_at_once || p.rules.max_pushed == 1 {
+                            bad.push(format!(
+                                "{}: a plan pushing one movable at a time exists, none found: \
+                                 {why}",
+                                p.name
+                            ));
+                        } else {
+                            match one_at_a_time_impossible(&p) {
+                                Some(false) => bad.push(format!(
+                                    "{}: blames pushes of several movables at once, but the \
+                                     exact planner finds a plan pushing one at a time",
+                                    p.name
+                                )),
+                                Some(true) => several_confirmed += 1,
+                                None => {}
+                            }
+                        }
+                    }
+                }
             }
+            Err(e) => bad.push(format!("{}: a plan exists, but: {e}", p.name)),
         }
     }
     let secs = t0.elapsed().as_secs_f64();
     eprintln!(
         "{plans} plans ({} with 2, {} with 3, {} with 4 movables; {steps} steps) from {instances} \
          instances; {mismatched_steps} steps in {mismatched_plans} plans cost other than the \
-         metric says; {missed} solvable instances without a plan; {exact} checked against the \
-         optimum; {secs:.1} s",
+         metric says; {missed} solvable instances without a plan ({budget} budget spent, \
+         {several} needing pushes of several movables at once, {several_confirmed} of them \
+         confirmed by the exact planner); {exact} plans checked against the optimum; {secs:.1} s",
         by_movables[2], by_movables[3], by_movables[4]
     );
     assert!(bad.is_empty(), "{} failures:\n{}", bad.len(), bad.join("\n"));
     assert!(by_movables[2..].iter().all(|&c| c >= 100), "{by_movables:?}");
+}
+
+/// Has the problem no plan when one move may push only one movable? `None` when its exact map
+/// has more than [`ONE_AT_A_TIME_UP_TO`] configurations.
+fn one_at_a_time_impossible(p: &Problem) -> Option<bool> {
+    let mut one = p.clone();
+    one.rules.max_pushed = 1;
+    let model = Model::new(&one).expect("the same problem");
+    (model.n_states <= ONE_AT_A_TIME_UP_TO).then(|| {
+        let map = cost_map(&model).expect("small maps do not overflow");
+        map.get(model.pack(&one.start).expect("start is free"))
+            .is_none()
+    })
 }
