@@ -46,7 +46,10 @@ fn place(
             },
         };
         let cs = cells(spec, pl);
-        if cs.iter().all(|&(x, y)| g.free(x, y) && !taken.contains(&(x, y))) {
+        if cs
+            .iter()
+            .all(|&(x, y)| g.free(x, y) && !taken.contains(&(x, y)))
+        {
             return Some(pl);
         }
     }
@@ -250,7 +253,10 @@ fn replay(p: &Problem, model: &Model, plan: &PracticalPlan) -> Result<Vec<Mismat
     }
     let sum: u32 = plan.moves.iter().map(|m| m.cost).sum();
     if plan.cost != sum {
-        return Err(format!("plan cost {} but its steps sum to {sum}", plan.cost));
+        return Err(format!(
+            "plan cost {} but its steps sum to {sum}",
+            plan.cost
+        ));
     }
     Ok(out)
 }
@@ -309,7 +315,10 @@ fn every_practical_step_costs_what_the_metric_charges() {
                     let map = cost_map(&model).expect("small maps do not overflow");
                     let opt = map.get(model.pack(&p.start).expect("start is free"));
                     if opt.is_none_or(|o| plan.cost < o) {
-                        bad.push(format!("{}: cost {} but the optimum is {opt:?}", p.name, plan.cost));
+                        bad.push(format!(
+                            "{}: cost {} but the optimum is {opt:?}",
+                            p.name, plan.cost
+                        ));
                     }
                 }
             }
@@ -363,8 +372,16 @@ fn every_practical_step_costs_what_the_metric_charges() {
          confirmed by the exact planner); {exact} plans checked against the optimum; {secs:.1} s",
         by_movables[2], by_movables[3], by_movables[4]
     );
-    assert!(bad.is_empty(), "{} failures:\n{}", bad.len(), bad.join("\n"));
-    assert!(by_movables[2..].iter().all(|&c| c >= 100), "{by_movables:?}");
+    assert!(
+        bad.is_empty(),
+        "{} failures:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+    assert!(
+        by_movables[2..].iter().all(|&c| c >= 100),
+        "{by_movables:?}"
+    );
 }
 
 /// Has the problem no plan when one move may push only one movable? `None` when its exact map

@@ -119,7 +119,9 @@ pub enum PracticalError {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum GaveUp {
     /// Its last round expanded [`Options::max_expansions`] nodes; a larger budget may find one.
-    #[error("the budget of {limit} object-level nodes was spent (raise the node budget)")]
+    #[error(
+        "the budget of {limit} object-level nodes was spent (raise `Options::max_expansions`)"
+    )]
     Budget {
         /// The budget of one round.
         limit: usize,
@@ -215,18 +217,15 @@ impl From<ProblemError> for Stop {
 }
 
 /// One object-level search; `wide` parks any movable at every node.
-fn search(
-    p: &Problem,
-    opts: &Options,
-    wide: bool,
-    t0: Instant,
-) -> Result<PracticalPlan, Stop> {
+fn search(p: &Problem, opts: &Options, wide: bool, t0: Instant) -> Result<PracticalPlan, Stop> {
     let r = p.movables.len();
     if p.start.movables.len() != r || p.goal_movables.len() != r {
         return Err(ProblemError::Invalid("start and goal must place every movable".into()).into());
     }
     // Per movable: the cheapest push (robot step + push), and whether it can reach its goal alone.
-    let relaxation_proves = p.rules.distance_limit.is_none() && p.rules.max_pushed <= 1;
+    // That proves something only when one move pushes one movable: a chain of pushes moves the
+    // last movable without the robot at one of its contact modes.
+    let relaxation_proves = p.rules.distance_limit.is_none() && p.rules.max_pushed == 1;
     let per_push = (0..r)
         .map(|i| cheapest_push_or_proof(p, i, relaxation_proves))
         .collect::<Result<Vec<u32>, PracticalError>>()
