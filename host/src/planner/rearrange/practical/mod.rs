@@ -119,9 +119,7 @@ pub enum PracticalError {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum GaveUp {
     /// Its last round expanded [`Options::max_expansions`] nodes; a larger budget may find one.
-    #[error(
-        "the budget of {limit} object-level nodes was spent (raise `Options::max_expansions`)"
-    )]
+    #[error("the budget of {limit} object-level nodes was spent (raise `Options::max_expansions`)")]
     Budget {
         /// The budget of one round.
         limit: usize,
