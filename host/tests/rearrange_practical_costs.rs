@@ -228,8 +228,9 @@ fn replay(p: &Problem, model: &Model, plan: &PracticalPlan) -> Result<Vec<Mismat
             .find(|s| s.dir == m.dir && same_kind(s.kind) && arrives(s.to))
             .ok_or_else(|| {
                 format!(
-                    "step {k} ({:?} {:?} to {:?}) is not an admissible move of the problem DBG {:?} noleave {:?}",
-                    m.action, m.dir, m.config, p.rules, m.config.movables.iter().map(|pl| p.grid.get(pl.x, pl.y).map(|c| c.no_leave)).collect::<Vec<_>>()
+                    "step {k} ({:?} {:?} to {:?}) is not an admissible move of the problem \
+                     under {:?}",
+                    m.action, m.dir, m.config, p.rules
                 )
             })?;
         if step.cost != m.cost {
@@ -271,7 +272,7 @@ const ONE_AT_A_TIME_UP_TO: u64 = 40_000_000;
 #[test]
 fn every_practical_step_costs_what_the_metric_charges() {
     let t0 = Instant::now();
-    let mut rng = ChaCha8Rng::seed_from_u64(52_000);
+    let mut rng = ChaCha8Rng::seed_from_u64(2026);
     let (mut plans, mut instances, mut steps, mut exact) = (0, 0, 0, 0);
     let mut by_movables = [0usize; 5];
     let mut bad: Vec<String> = Vec::new();
