@@ -3,7 +3,7 @@
 //! the exact map, every practical plan must be a legal pushing path under the full problem's
 //! admissibility and metric, cost no less than the optimum, and almost always close to it.
 
-use pushbot::planner::rearrange::practical::{Options, PracticalError, plan_practical};
+use pushbot::planner::rearrange::practical::{Action, Options, PracticalError, plan_practical};
 use pushbot::planner::rearrange::problem::Cell;
 use pushbot::planner::rearrange::{
     Config, Dir, Grid, Metric, Model, MovableSpec, Placement, Problem, RobotSpec, Rules, cost_map,
@@ -190,4 +190,61 @@ fn a_box_that_cannot_reach_its_goal_even_alone_proves_no_plan_exists() {
         "{e}: alone, b0 could reach its goal, so nothing is proven"
     );
     assert!(e.to_string().starts_with("no plan found"));
+}
+
+/// Two one-cell boxes in an open 7 × 5 room, the robot at (1, 2).
+fn two_boxes(b0: (i32, i32), g0: (i32, i32), b1: (i32, i32), g1: (i32, i32)) -> Problem {
+    let mut p = random_problem(&mut ChaCha8Rng::seed_from_u64(1), 2).unwrap();
+    p.grid = Grid::new(7, 5);
+    p.metric = Metric::default();
+    p.movables = (0..2)
+        .map(|i| MovableSpec::with_faces(&format!("b{i}"), vec![(0, 0)], 1))
+        .collect();
+    p.start.robot = (1, 2);
+    let at = |(x, y): (i32, i32)| Placement { x, y, o: 0 };
+    p.start.movables = vec![at(b0), at(b1)];
+    p.goal_movables = vec![Some(at(g0)), Some(at(g1))];
+    p
+}
+
+#[test]
+fn a_push_beside_a_movable_held_still_costs_what_the_exact_planner_charges() {
+    // b0 is pushed twice east past b1, which sits at its goal diagonally below: the safety term
+    // counts walls and the border, not b1, so the plan costs 2 × (robot 1 + box 1).
+    let mut p = two_boxes((2, 2), (4, 2), (3, 3), (3, 3));
+    p.metric.safety = 5;
+    let model = Model::new(&p).unwrap();
+    let opt = cost_map(&model)
+        .unwrap()
+        .get(model.pack(&p.start).unwrap())
+        .unwrap();
+    assert_eq!(opt, 4);
+    let plan = plan_practical(&p, &Options::for_problem(&p)).unwrap();
+    let configs: Vec<Config> = plan.moves.iter().map(|m| m.config.clone()).collect();
+    assert_eq!(replay_cost(&model, &p.start, &configs), Some(plan.cost));
+    assert!(plan.moves.iter().all(|m| m.cost == 2), "{:?}", plan.moves);
+    assert_eq!(plan.cost, opt);
+}
+
+#[test]
+fn a_movable_left_where_none_may_be_left_is_pushed_last() {
+    // b0's goal is a no-leave cell: the cheaper order (b0 first) would leave it there while b1
+    // is pushed, which the rules forbid, so b1 goes first.
+    let mut p = two_boxes((2, 1), (3, 1), (2, 3), (4, 3));
+    p.grid.at_mut(3, 1).no_leave = true;
+    let model = Model::new(&p).unwrap();
+    let opt = cost_map(&model)
+        .unwrap()
+        .get(model.pack(&p.start).unwrap())
+        .unwrap();
+    let plan = plan_practical(&p, &Options::for_problem(&p)).unwrap();
+    let configs: Vec<Config> = plan.moves.iter().map(|m| m.config.clone()).collect();
+    assert_eq!(replay_cost(&model, &p.start, &configs), Some(plan.cost));
+    assert!(plan.cost >= opt);
+    let last_push = plan
+        .moves
+        .iter()
+        .rev()
+        .find(|m| m.action != Action::Transit);
+    assert_eq!(last_push.map(|m| m.action), Some(Action::Push(0)));
 }

@@ -93,6 +93,35 @@ pub fn sub_problem(p: &Problem, cur: &Config, i: Option<usize>, bare: bool) -> P
     }
 }
 
+/// The model of a leg's sub-problem with the costs D of the full problem. The movables held
+/// fixed are obstacles of the sub-problem for admissibility (§IV-B) only: the metric (§IV-C)
+/// takes its passability and its safety term from the table's own cells, where the safety term
+/// counts static obstacles and the border, never a movable — the same costs the exact planner
+/// gives the same moves.
+pub fn leg_model(p: &Problem, sub: &Problem) -> Result<Model, ProblemError> {
+    let mut model = Model::new(sub)?;
+    let (metric, table) = (&p.metric, &p.grid);
+    model.robot_cost = model
+        .robot
+        .cells
+        .iter()
+        .map(|cs| metric.move_cost(p.robot.mass, cs, table))
+        .collect();
+    model.push_cost = model
+        .movables
+        .iter()
+        .zip(&sub.movables)
+        .map(|(d, spec)| {
+            d.cells
+                .iter()
+                .map(|cs| metric.push_cost(spec.mass, cs, table))
+                .collect()
+        })
+        .collect();
+    model.max_edge = metric.max_edge(sub, &model.robot_cost, &model.push_cost);
+    Ok(model)
+}
+
 /// What a leg search looks for.
 pub struct Wanted<'a> {
     /// The movable's goal (`None`: no direct leg wanted).
@@ -114,7 +143,7 @@ pub fn legs(
     want: &Wanted,
 ) -> Result<Legs, ProblemError> {
     let sub = sub_problem(p, cur, i, bare);
-    let model = Model::new(&sub)?;
+    let model = leg_model(p, &sub)?;
     let start = model
         .pack(&sub.start)
         .ok_or_else(|| ProblemError::Invalid("leg start not free".into()))?;

@@ -12,10 +12,16 @@
 //! the anchor's Manhattan distance times the cheapest push (a lower bound for translational
 //! pushes; rotations may shift the anchor further). The plan is legal under the full problem's
 //! rules (a distance limit binds the robot to the movables held fixed too); it pushes one
-//! movable at a time, and it is not proven optimal. When the
-//! search ends without a plan it says "no plan found", unless some movable cannot reach its goal
-//! even alone on the table, which proves that no plan exists (one movable pushed at a time, no
-//! distance limit).
+//! movable at a time, and it is not proven optimal. When the search ends without a plan it says
+//! "no plan found" and why it gave up: its node budget spent, or every configuration it reaches
+//! tried (naming the pushes of several movables at once that the rules allow and this mode never
+//! makes) — unless some movable cannot reach its goal even alone on the table, which proves that
+//! no plan exists (one movable pushed at a time, no distance limit).
+//!
+//! Every move is charged what the exact planner charges it (§IV-C): a leg's sub-problem holds
+//! the other movables as obstacles for admissibility only, its costs are the full table's
+//! ([`leg::leg_model`]), and a movable left where movables may not be left must be the next one
+//! pushed, as §IV-B's admissibility demands after every move.
 
 pub mod leg;
 
@@ -25,7 +31,7 @@ use std::time::Instant;
 
 pub use leg::{Action, Leg, Move};
 
-use super::problem::{Config, Dir, Model, Placement, Problem, ProblemError};
+use super::problem::{Config, Dir, Placement, Problem, ProblemError};
 
 /// How hard the object-level search tries.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,10 +98,14 @@ impl PracticalPlan {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum PracticalError {
     /// The search ended without a plan; one may still exist.
-    #[error("no plan found (searched {expansions} object-level nodes; a plan may still exist)")]
+    #[error(
+        "no plan found (searched {expansions} object-level nodes; a plan may still exist): {why}"
+    )]
     NoPlanFound {
-        /// Nodes expanded.
+        /// Nodes expanded, over every round of the search.
         expansions: usize,
+        /// Why the search gave up.
+        why: GaveUp,
     },
     /// Proven: this movable cannot reach its goal even alone on the table.
     #[error("no plan exists: movable `{0}` cannot reach its goal even alone on the table")]
@@ -103,6 +113,35 @@ pub enum PracticalError {
     /// The description is wrong.
     #[error(transparent)]
     Problem(#[from] ProblemError),
+}
+
+/// Why the object-level search gave up without a plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum GaveUp {
+    /// Its last round expanded [`Options::max_expansions`] nodes; a larger budget may find one.
+    #[error("the budget of {limit} object-level nodes was spent (raise `Options::max_expansions`)")]
+    Budget {
+        /// The budget of one round.
+        limit: usize,
+    },
+    /// Every configuration this mode reaches was expanded: one movable pushed at a time, to its
+    /// goal or parked on one of the `parkings` cheapest placements of each leg search.
+    #[error(
+        "every configuration reached by pushing one movable at a time (parking each on up to \
+         {parkings} placements) was tried{}",
+        if *several_at_once {
+            "; the rules let one move push several movables, which this mode never does, and a \
+             plan may need it"
+        } else {
+            ""
+        }
+    )]
+    Exhausted {
+        /// Parking placements tried per movable and node in the last round.
+        parkings: usize,
+        /// The rules let one move push several movables (`max_pushed` is not 1).
+        several_at_once: bool,
+    },
 }
 
 /// One object-level node: where it is, what it cost, how it got there.
@@ -113,39 +152,82 @@ struct Node {
     leg: Vec<Move>,
 }
 
-/// Plan a rearrangement with the object-level search: first parking only the movables in the
-/// way, then, if that finds nothing, parking any movable at every node.
+/// Plan a rearrangement with the object-level search in rounds: first parking only the
+/// movables in the way, then, if that finds nothing, parking any movable at every node, and
+/// when that round ran out of nodes with some leg's parkings cut short, once more with four
+/// times the parkings. Without a plan it says why the last round gave up ([`GaveUp`]).
 pub fn plan_practical(p: &Problem, opts: &Options) -> Result<PracticalPlan, PracticalError> {
     let t0 = Instant::now();
-    match search(p, opts, false, t0) {
-        Err(PracticalError::NoPlanFound { expansions }) => {
-            search(p, opts, true, t0).map_err(|e| match e {
-                PracticalError::NoPlanFound { expansions: more } => PracticalError::NoPlanFound {
-                    expansions: expansions + more,
-                },
-                e => e,
-            })
+    let mut expansions = 0;
+    let mut round = |wide: bool, parkings: usize| {
+        let o = Options { parkings, ..*opts };
+        let r = search(p, &o, wide, t0);
+        if let Err(Stop::Exhausted { nodes, .. } | Stop::Budget { nodes }) = &r {
+            expansions += nodes;
         }
-        r => r,
+        r
+    };
+    let mut last = round(false, opts.parkings);
+    if matches!(last, Err(Stop::Exhausted { .. } | Stop::Budget { .. })) {
+        last = round(true, opts.parkings);
+    }
+    if let Err(Stop::Exhausted { cut: true, .. }) = last {
+        last = round(true, 4 * opts.parkings);
+    }
+    let several_at_once = p.rules.max_pushed != 1 && p.movables.len() > 1;
+    last.map_err(|stop| match stop {
+        Stop::Error(e) => e,
+        Stop::Budget { .. } => PracticalError::NoPlanFound {
+            expansions,
+            why: GaveUp::Budget {
+                limit: opts.max_expansions,
+            },
+        },
+        Stop::Exhausted { parkings, .. } => PracticalError::NoPlanFound {
+            expansions,
+            why: GaveUp::Exhausted {
+                parkings,
+                several_at_once,
+            },
+        },
+    })
+}
+
+/// How one round of the search ended without a plan.
+enum Stop {
+    /// It expanded its whole budget of `nodes`.
+    Budget { nodes: usize },
+    /// It ran out of nodes after `nodes`; `cut`: some leg found as many parkings as it was
+    /// allowed (more might have helped), each leg `parkings` of them.
+    Exhausted {
+        nodes: usize,
+        cut: bool,
+        parkings: usize,
+    },
+    /// The problem is wrong or no plan exists.
+    Error(PracticalError),
+}
+
+impl From<ProblemError> for Stop {
+    fn from(e: ProblemError) -> Stop {
+        Stop::Error(e.into())
     }
 }
 
 /// One object-level search; `wide` parks any movable at every node.
-fn search(
-    p: &Problem,
-    opts: &Options,
-    wide: bool,
-    t0: Instant,
-) -> Result<PracticalPlan, PracticalError> {
+fn search(p: &Problem, opts: &Options, wide: bool, t0: Instant) -> Result<PracticalPlan, Stop> {
     let r = p.movables.len();
     if p.start.movables.len() != r || p.goal_movables.len() != r {
         return Err(ProblemError::Invalid("start and goal must place every movable".into()).into());
     }
     // Per movable: the cheapest push (robot step + push), and whether it can reach its goal alone.
-    let relaxation_proves = p.rules.distance_limit.is_none() && p.rules.max_pushed <= 1;
+    // That proves something only when one move pushes one movable: a chain of pushes moves the
+    // last movable without the robot at one of its contact modes.
+    let relaxation_proves = p.rules.distance_limit.is_none() && p.rules.max_pushed == 1;
     let per_push = (0..r)
         .map(|i| cheapest_push_or_proof(p, i, relaxation_proves))
-        .collect::<Result<Vec<u32>, PracticalError>>()?;
+        .collect::<Result<Vec<u32>, PracticalError>>()
+        .map_err(Stop::Error)?;
     let h = |c: &Config| -> u32 {
         (0..r)
             .filter_map(|i| {
@@ -178,6 +260,7 @@ fn search(
     )));
     let mut expansions = 0;
     let mut settled = 0;
+    let mut cut = false;
     let ncells = (p.grid.w * p.grid.h) as usize;
     while let Some(Reverse((_, _, id))) = heap.pop() {
         let (config, g) = (nodes[id].config.clone(), nodes[id].g);
@@ -188,14 +271,20 @@ fn search(
             return Ok(finish(p, &nodes, id, expansions, settled, t0));
         }
         if expansions >= opts.max_expansions {
-            break;
+            return Err(Stop::Budget { nodes: expansions });
         }
         expansions += 1;
         let mut children: Vec<Leg> = Vec::new();
         let unplaced: Vec<usize> = (0..r)
             .filter(|&i| p.goal_movables[i].is_some_and(|g| config.movables[i] != g))
             .collect();
-        if unplaced.is_empty() {
+        // A movable on a cell where none may be left must be the one pushed next (§IV-B: after
+        // every move, each movable not pushed lies where it may be left).
+        let unleavable: Vec<usize> = (0..r)
+            .filter(|&j| !may_leave(p, j, config.movables[j]))
+            .collect();
+        let may_push = |i: Option<usize>| unleavable.iter().all(|&j| Some(j) == i);
+        if unplaced.is_empty() && may_push(None) {
             let want = leg::Wanted {
                 target: None,
                 robot_target: p.goal_robot,
@@ -210,7 +299,7 @@ fn search(
         // movable still to be placed, or anywhere when some movable has no direct leg.
         let mut stuck = false;
         let mut direct: Vec<Leg> = Vec::new();
-        for &i in &unplaced {
+        for &i in unplaced.iter().filter(|&&i| may_push(Some(i))) {
             let want = leg::Wanted {
                 target: p.goal_movables[i],
                 robot_target: None,
@@ -230,7 +319,7 @@ fn search(
                 i != j
                     && p.goal_movables[i].is_some_and(|g| overlaps(p, j, config.movables[j], i, g))
             });
-            if !(on_goal || stuck || wide) {
+            if !(on_goal || stuck || wide) || !may_push(Some(j)) {
                 continue;
             }
             // A parked movable must not cover the goal of another movable still to be placed.
@@ -248,6 +337,7 @@ fn search(
             };
             let legs = leg::legs(p, &config, Some(j), false, &want)?;
             settled += legs.settled;
+            cut |= legs.parkings.len() >= opts.parkings;
             children.extend(legs.parkings);
         }
         for mut leg in children {
@@ -267,7 +357,11 @@ fn search(
             heap.push(Reverse((key(f), Reverse(g2), nodes.len() - 1)));
         }
     }
-    Err(PracticalError::NoPlanFound { expansions })
+    Err(Stop::Exhausted {
+        nodes: expansions,
+        cut,
+        parkings: opts.parkings,
+    })
 }
 
 /// Forget the robot's last move when the metric does not charge it (fewer distinct nodes).
@@ -282,7 +376,7 @@ fn normalize(p: &Problem, c: &mut Config) {
 /// error if it cannot reach its goal even alone there (then no plan exists).
 fn cheapest_push_or_proof(p: &Problem, i: usize, proves: bool) -> Result<u32, PracticalError> {
     let bare = leg::sub_problem(p, &p.start, Some(i), true);
-    let model = Model::new(&bare)?;
+    let model = leg::leg_model(p, &bare)?;
     let robot_min = model.robot_cost.iter().copied().min().unwrap_or(1);
     let push_min = model.push_cost[0].iter().copied().min().unwrap_or(0);
     if proves
@@ -316,6 +410,14 @@ fn overlaps(p: &Problem, j: usize, a: Placement, i: usize, b: Placement) -> bool
         .cells_at(b.o)
         .iter()
         .any(|&(x, y)| cj.contains(&(b.x + x, b.y + y)))
+}
+
+/// May movable `j` be left at `pl` (no cell of it where movables may not be left)?
+fn may_leave(p: &Problem, j: usize, pl: Placement) -> bool {
+    p.movables[j]
+        .cells_at(pl.o)
+        .iter()
+        .all(|&(x, y)| p.grid.get(pl.x + x, pl.y + y).is_none_or(|c| !c.no_leave))
 }
 
 /// Mark the cells movable `j` covers at `pl`.
