@@ -1,4 +1,4 @@
-//! `pushbot scene check` on the checks of issue 18: what it normalised (a clockwise outline) is
+//! `pushbot scene check` on the scene checks: what it normalised (a clockwise outline) is
 //! said in text and JSON; a goal inside an obstacle and a bad `[stable]` value exit 2 naming
 //! the file, line, column and field; a 100 000-vertex circle is a simple polygon.
 

@@ -1,4 +1,4 @@
-//! The scene checks of issue 18: clockwise outlines normalised (and said so), goals and starts
+//! The scene checks: clockwise outlines normalised (and said so), goals and starts
 //! inside obstacles or off the table refused, the planners' sections checked with their field
 //! paths, marker heights, the camera's intrinsics file.
 

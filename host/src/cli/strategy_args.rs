@@ -86,7 +86,7 @@ pub enum KeepArg {
     Informative,
 }
 
-/// How the collection chooses and keeps its pushes (issue 24: fewer samples to learn).
+/// How the collection chooses and keeps its pushes (fewer samples to learn than the paper).
 #[derive(Args, Debug, Clone)]
 pub struct ActiveArgs {
     /// How the initial collection chooses its pushes.
@@ -191,7 +191,7 @@ pub struct EvalArgs {
 pub enum EvalCmd {
     /// Deliver the object from named start positions to the goal (Lau et al. Fig. 10–11).
     Delivery(Box<DeliveryArgs>),
-    /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds (issue 21).
+    /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds.
     Stable(super::stable_run::StableEvalArgs),
 }
 
