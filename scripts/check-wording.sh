@@ -12,7 +12,8 @@ pattern='\b([Ii]ssue|[Ss]ession)s?[[:space:]]+#?[0-9]+'
 
 check() {
   local dir=$1 hits
-  hits=$(git -C "$dir" grep -nIE "$pattern" -- . || true)
+  # This file names the forms it refuses (its examples and self-test), so it is left out.
+  hits=$(git -C "$dir" grep -nIE "$pattern" -- . ':!scripts/check-wording.sh' || true)
   if [ -n "$hits" ]; then
     echo "$hits" >&2
     echo "check-wording: $(grep -c . <<<"$hits") tracked lines name a tracker item or a numbered" \
