@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Recordings, replay and the report, as a user meets them (issue 23), run by scripts/test-all.sh:
+# Recordings, replay and the report, as a user meets them, run by scripts/test-all.sh:
 #
 # 1. `pushbot demo` writes run.mcap; Python's `mcap` reader lists its channels with Foxglove's
 #    schema names and decodes every message (scripts/check_mcap.py);

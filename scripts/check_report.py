@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Opens a pushbot report (report.html) in a real headless browser (Debian's `chromium`) and
 checks that every figure was drawn at a non-zero size from an image that loaded, that every
-figure has a caption, that no table cell holds raw JSON, and that the page logged no error.
+figure has a caption, that no table cell holds raw JSON, that no table labels a row or a column
+with a field name (snake_case) or shows a value with more than four significant digits, and
+that the page logged no error.
 
     python3 scripts/check_report.py DIR/report.html
     python3 scripts/check_report.py --self-test DIR/report.html   # also: a broken copy fails
@@ -40,7 +42,11 @@ f.addEventListener('load', () => {
   });
   const cells = [...d.querySelectorAll('td')].map(td => td.textContent.trim())
     .filter(t => /^[\\[{].*[\\]}]$/.test(t));
-  const out = JSON.stringify({title: d.title, figures, json_cells: cells, errors});
+  // Every header, and every cell that holds no table of its own (its text is one value).
+  const headers = [...d.querySelectorAll('th')].map(th => th.textContent.trim());
+  const leaves = [...d.querySelectorAll('td')].filter(td => !td.querySelector('table'))
+    .map(td => td.textContent.trim());
+  const out = JSON.stringify({title: d.title, figures, json_cells: cells, headers, leaves, errors});
   document.getElementById('out').textContent = 'RESULT:' + btoa(unescape(encodeURIComponent(out)));
 });
 </script></body></html>
@@ -60,6 +66,15 @@ def browser():
         if path:
             return path
     sys.exit("check_report: no chromium on PATH (scripts/test-all.sh installs Debian's chromium)")
+
+
+SNAKE = re.compile(r"\b[a-z][a-z0-9]*_[a-z0-9_]+\b")
+DECIMAL = re.compile(r"\d+\.\d+")
+
+
+def too_precise(text):
+    """Whether a cell shows a decimal number of more than four significant digits."""
+    return any(len(n.replace(".", "").lstrip("0")) > 4 for n in DECIMAL.findall(text))
 
 
 def check(report):
@@ -96,6 +111,11 @@ def check(report):
         if not fig["caption"]:
             failures.append(f"figure {fig['src']}: no caption")
     failures += [f"raw JSON in a table cell: {c[:80]}" for c in result["json_cells"]]
+    # Tables read like a product's: labels, not field names; values rounded.
+    failures += [f"a field name for a label: {h!r}" for h in result.pop("headers")
+                 if SNAKE.search(h)]
+    failures += [f"a value with more than 4 significant digits: {c!r}"
+                 for c in result.pop("leaves") if too_precise(c)]
     result.update(report=report, failures=failures)
     return result
 
@@ -120,10 +140,13 @@ def main(argv):
                 return 1
             os.remove(os.path.join(tmp, imgs[0]))
             html = html.replace(f'<img src="{imgs[1]}"', f'<img style="height:0" src="{imgs[1]}"', 1)
+            # A raw field name and an unrounded value must fail too.
+            html = html.replace("</table>", "<tr><th>final_distance_m</th><td>0.012834</td></tr></table>", 1)
             open(os.path.join(tmp, "report.html"), "w").write(html)
             broken = check(os.path.join(tmp, "report.html"))
             found = "\n".join(broken["failures"])
-            if imgs[0] not in found or imgs[1] not in found:
+            if (imgs[0] not in found or imgs[1] not in found or "'final_distance_m'" not in found
+                    or "'0.012834'" not in found):
                 print(f"self-test: a broken report passed: {broken['failures']}", file=sys.stderr)
                 code = 1
             else:

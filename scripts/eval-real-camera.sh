@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 20's last line, measured: learned delivery (Lau et al.) through the serial port and the
+# Learned delivery (Lau et al.) through the serial port and the
 # camera from the Fig. 10/11 starts A–F, an ideal camera against a webcam lens (k1 = −0.08,
 # f = 700 px, given as the scene's intrinsics file) with the robot's marker 6 cm and the
 # object's 3 cm above the table. One strategy, collected in process, serves every trial.

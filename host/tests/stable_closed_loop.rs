@@ -1,4 +1,4 @@
-//! Closed-loop stable pushing in perturbed simulated worlds (issue 21): the robot-scale Fig. 15
+//! Closed-loop stable pushing in perturbed simulated worlds: the robot-scale Fig. 15
 //! task planned with the nominal model, driven on the in-process simulated robot whose world
 //! runs a drawn perturbation (start ±5°, ±10 mm; frictions ±30 %; centre of friction; wheel
 //! slip; a noisy camera). Judged by the simulator's true slider pose.

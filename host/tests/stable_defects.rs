@@ -1,4 +1,4 @@
-//! The stable planner's known defects of issue 21 (D1–D8), one test each: every test failed
+//! The stable planner's known defects (D1–D8), one test each: every test failed
 //! before its fix. Scenes are written inline in the shared scene format with a `[stable]`
 //! section.
 

@@ -1,4 +1,4 @@
-//! Issue 21, item 5: wheeled pushers plan in random scenes where a plan exists. Over fixed
+//! Wheeled pushers plan in random scenes where a plan exists. Over fixed
 //! seeds of `planner::stable::random_scene`, a plan exists when the planner finds one or a
 //! harder search (grid halved in x, y and θ, more nodes, plain A*) does; the planner must find
 //! one in at least 80 % of those scenes for a car and an omnidirectional robot and 90 % for the

@@ -1,4 +1,4 @@
-//! Random stable-pushing scenes executed (issue 21): scenes of
+//! Random stable-pushing scenes executed: scenes of
 //! `planner::stable::random_scene` planned with the nominal model (Lynch & Mason §4) and driven
 //! closed loop on the perturbed in-process simulated robot, which starts at a free pose of any
 //! heading and first drives to the plan's first edge. Judged by the simulator's true slider

@@ -1,5 +1,5 @@
-//! Validation of stable pushing in the simulated world (Lynch & Mason 1996 §4, issue 7 item
-//! 4): a plan for the differential-drive robot with a flat front plate is executed open loop on
+//! Validation of stable pushing in the simulated world (Lynch & Mason 1996
+//! §4): a plan for the differential-drive robot with a flat front plate is executed open loop on
 //! the simulated robot, through the firmware protocol in process (`SimRobot`, `Velocity` arcs),
 //! and the slider must stay fixed to the plate during every stable push (drift < 1 mm per
 //! 100 mm pushed and < 1°) and end in the goal neighbourhood. This checks the planner's STABLE

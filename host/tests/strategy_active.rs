@@ -1,4 +1,4 @@
-//! Issue 24, fewer samples to learn: the active collection (uncertain initial pushes, a short
+//! Fewer samples to learn than the paper: the active collection (uncertain initial pushes, a short
 //! initial collection, only informative supplemental samples) reaches Lau et al.'s 10-streak
 //! (§III-D) within 300 samples, and the data-need curve (`eval delivery --figure 7`) has its
 //! shape.

@@ -238,7 +238,7 @@ fn collect_once_then_deliver_around_a_wall_from_the_cache() {
         .expect("the object passed the wall's x");
     assert!(crossing.y < 0.55, "crossed at {crossing:?}");
     // Following the path's moving sub-goal, the object's path is within 1.3× the shortest
-    // collision-free path of its bounding circle (issue 24), measured on the camera's track.
+    // collision-free path of its bounding circle, measured on the camera's track.
     let shortest = shortest_object_path(
         &SimRobot::new(scene.clone(), None, None, sim)
             .unwrap()

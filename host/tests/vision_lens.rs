@@ -1,4 +1,4 @@
-//! A camera with a real lens (issue 20): frames rendered through OpenCV's `plumb_bob` distortion
+//! A camera with a real lens: frames rendered through OpenCV's `plumb_bob` distortion
 //! (k1 = −0.08, f = 700 px — a typical webcam). With the true intrinsics the detected corners
 //! are undistorted before calibration and measurement, and bodies are placed as well as by an
 //! ideal camera; without them the same frames put bodies millimetres off.
@@ -267,7 +267,7 @@ fn calibrate_and_track_through_a_lens_on_the_command_line() {
     assert!(err.contains("640×480") && err.contains("960×720"), "{err}");
 }
 
-/// Markers at their true heights (issue 20): the robot's marker 6 cm and the objects' 3 cm above
+/// Markers at their true heights: the robot's marker 6 cm and the objects' 3 cm above
 /// the table, seen through the lens in perspective. With the heights in the layout (the scene
 /// markers' `z`) and the lens known, the calibration knows the camera's centre and each marker
 /// is placed where its rays meet its own plane; with the heights left out, the same frames put

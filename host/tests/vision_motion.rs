@@ -1,4 +1,4 @@
-//! A camera as it really is, with the robot moving (issue 20): the simulator's camera renders a
+//! A camera as it really is, with the robot moving: the simulator's camera renders a
 //! scene frame by frame while the robot follows a scripted motion — a camera tilted 35°, the
 //! robot spinning in place at 180°/s, driving fast with its marker smeared over a 1/30 s
 //! exposure, a hand over the table — and the whole pipeline (detector, calibration through the

@@ -15,7 +15,7 @@ use pushbot::vision::{Pipeline, RoiParams, measure};
 use pushbot_sim::camera::CameraFrame;
 use pushbot_sim::camera::server::CameraServer;
 
-/// Issue 5's acceptance: on 300 rendered frames, body position error median ≤ 1.5 mm and 99th
+/// The pipeline's accuracy: on 300 rendered frames, body position error median ≤ 1.5 mm and 99th
 /// percentile ≤ 4 mm, heading median ≤ 0.5°, ≥ 99.5 % of fully visible markers found, no
 /// wrong ids. The camera is calibrated from the first frames' calibration markers, as
 /// `pushbot calibrate` does.
@@ -122,7 +122,7 @@ fn calibrated_pipeline(layout: &MarkerLayout, first: &[synth::SynthFrame]) -> Pi
 }
 
 /// The chosen pipeline (C AprilTag in tracker-guided regions of interest, whole frames every
-/// 15 frames or when a body is missed) meets issue 5's accuracy on a rendered video where the
+/// 15 frames or when a body is missed) meets the accuracy of `accuracy_on_rendered_frames` on a rendered video where the
 /// bodies move, and it does search regions rather than whole frames most of the time.
 #[test]
 fn regions_of_interest_keep_accuracy_on_video() {
@@ -167,7 +167,7 @@ fn regions_of_interest_keep_accuracy_on_video() {
 /// A camera read only now and then (every 8th frame of the video: 0.27 s apart, as the
 /// in-process robot looks between its moves) still searches regions rather than whole frames:
 /// each is centred on the last sighting and reaches as far as a marker can go in the gap
-/// ([`RoiParams::max_speed`]). Nothing is missed and the poses keep issue 5's accuracy.
+/// ([`RoiParams::max_speed`]). Nothing is missed and the poses keep that accuracy.
 #[test]
 fn regions_of_interest_reach_across_long_gaps() {
     let layout = MarkerLayout::default_table();

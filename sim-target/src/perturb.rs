@@ -1,4 +1,4 @@
-//! One perturbed world per trial (issue 21): the simulated world runs values drawn from a
+//! One perturbed world per trial: the simulated world runs values drawn from a
 //! scene's `[perturb]` ranges ([`pushbot_world::scene::perturb::Perturb`]) while the planner
 //! keeps the nominal ones — Lynch & Mason's stable pushes (§3) are planned with a friction
 //! guess and a known start, and this is how far the world may be from both. A draw is a

@@ -66,7 +66,7 @@ pub struct SimOptions {
     pub perturb: Option<crate::perturb::Perturbation>,
 }
 
-/// An object moved by hand mid-run (issue 22): at `at_s` seconds of simulated time `object` is
+/// An object moved by hand mid-run: at `at_s` seconds of simulated time `object` is
 /// lifted and put down `by` (dx, dy in metres, dθ in radians, table frame) from where it is.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Disturbance {

@@ -219,7 +219,7 @@ fn bumper_touches_a_non_convex_object_at_two_places() {
 }
 
 proptest! {
-    // A fixed seed: the same twelve cases every run. With a random one, a CI run (session 10)
+    // A fixed seed: the same twelve cases every run. With a random one, a CI run
     // found a 6.4 µm penetration (seed 209, duties from (0.113, 0.311)), over the 1 µm bound
     // derived below: a solver issue left open, not a flake to retry.
     #![proptest_config(ProptestConfig {

@@ -1,4 +1,4 @@
-//! Bad input (issue 9, item 3): the real `pushbot` and `pushbot-sim` binaries on malformed
+//! Bad input: the real `pushbot` and `pushbot-sim` binaries on malformed
 //! scenes, strategy files, calibrations, devices and arguments. Each must exit with code 2,
 //! not panic, and say what is wrong and where (file, line and field; the flag; the device).
 //!

@@ -1,4 +1,4 @@
-//! Bad input (issue 9, item 3), continued from `bad_input.rs`: the real `pushbot` and
+//! Bad input, continued from `bad_input.rs`: the real `pushbot` and
 //! `pushbot-sim` binaries on malformed strategy files, calibrations, serial ports, cameras,
 //! numbers and arguments. Each must exit with code 2, not panic, and say what is wrong and where
 //! (file, line and field; the flag; the device).

@@ -243,7 +243,7 @@ fn exact_goal_finishes_a_car_plan_and_says_clearly_when_nothing_finishes() {
     assert_eq!(v["found"], true, "{v}");
     assert_eq!(v["exact_goal"], true, "{v}");
     // Fig. 16's slot with the goal moved 5 mm into the right-hand obstacle: such a goal is
-    // refused when the scene is read (issue 18), naming the goal, the obstacle and where the
+    // refused when the scene is read, naming the goal, the obstacle and where the
     // goal is written — before any planning, with or without --exact-goal.
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = dir.path().join("fig16-wall.toml");

@@ -22,7 +22,7 @@ fn the_stable_stage_runs_and_writes_the_report() {
     let stage = &summary["stages"][0];
     assert_eq!(stage["id"], "stable");
     assert!(stage["numbers"]["pushed_m"].as_f64().expect("pushed") > 0.3);
-    // Closed loop (issue 21): it counts its re-plans, and the plan figure draws the executed
+    // Closed loop: it counts its re-plans, and the plan figure draws the executed
     // path (green) over the planned one.
     assert!(stage["numbers"]["replans"].as_u64().is_some(), "{stage:#}");
     let plan_svg = std::fs::read_to_string(out.join("stable-plan.svg")).expect("stable-plan.svg");
@@ -73,7 +73,7 @@ fn an_unknown_stage_or_scene_is_bad_input() {
 
 #[test]
 fn the_rearrangement_reaches_its_goal_through_link_cuts() {
-    // Issue 19: a 1 s cut every 5 s of robot time, the robot's watchdog at 1 s: cuts stop the
+    // A 1 s cut every 5 s of robot time, the robot's watchdog at 1 s: cuts stop the
     // robot mid-push or while it stands; each is recovered and the stage still ends at its goal.
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("report");

@@ -94,7 +94,7 @@ fn moves_complete_despite_drops_corruption_and_cuts() {
     assert!(stats.frames_ok > 100, "{stats:?}");
 }
 
-/// Issue 19: `pushbot-sim --faults --fault-drop 0.01 --fault-corrupt 0.01` — the `--faults`
+/// `pushbot-sim --faults --fault-drop 0.01 --fault-corrupt 0.01` — the `--faults`
 /// profile's 20 ms delays and 300 ms cut every 10 s included — and 30 `pushbot robot move` in a
 /// row, each its own session: all 30 complete. A cut longer than the robot's 200 ms watchdog
 /// stops a move; the host recovers the link and sends the rest of the move anew.

@@ -203,7 +203,7 @@ fn mission_time_counts_host_work_at_wall_clock_rate() {
     t.shutdown().expect("sim ran cleanly");
 }
 
-/// Issue 20: the simulated camera sees the table through a webcam's lens (k1 = −0.08, f =
+/// The simulated camera sees the table through a webcam's lens (k1 = −0.08, f =
 /// 700 px), given as the scene's intrinsics. The host, knowing the lens, places the robot near a
 /// corner of the image within 2 mm; told nothing of it, the same frames put it ~10 mm off.
 #[test]

@@ -1,4 +1,4 @@
-//! A port that disappears and comes back (issue 19, item 5), over a real pty: the simulator keeps
+//! A port that disappears and comes back, over a real pty: the simulator keeps
 //! a stable link path to its pty (as udev keeps `/dev/serial/by-id/…`), drops the pty and serves
 //! a new one behind the same path. With a reconnect time the host waits for it, opens a new
 //! session and goes on; without one it fails at once with an error that says what to do.

@@ -1,4 +1,4 @@
-//! `pushbot run stable` and `pushbot eval stable` (issue 21), the real binary: bad input — a
+//! `pushbot run stable` and `pushbot eval stable`, the real binary: bad input — a
 //! malformed `[perturb]` section, a scene that is neither a preset nor a file, a scene whose
 //! pusher the robot is not — exits 2 with the reason and where; and one perturbed trial in
 //! process with `--json`, whose summary carries `trials` and `reached`.

@@ -89,7 +89,7 @@ fn collect_and_deliver_one_object_through_the_port_and_the_camera() {
     t.shutdown().expect("sim ran cleanly");
 }
 
-/// The camera as it is (issue 20): a webcam lens (k1 = −0.08, given as the scene's intrinsics
+/// The camera as it is: a webcam lens (k1 = −0.08, given as the scene's intrinsics
 /// file), the robot's marker 6 cm and the object's 3 cm above the table. A strategy collected in
 /// process delivers the object through the serial port and this camera from Lau et al.'s start C.
 #[test]

@@ -1,4 +1,4 @@
-//! HIL (issue 20): the robot driving at full speed and spinning at 360°/s in front of a camera as it is —
+//! HIL: the robot driving at full speed and spinning at 360°/s in front of a camera as it is —
 //! a webcam lens, a 1/30 s exposure that smears a moving marker, markers at their heights — with
 //! the robot's telemetry over the serial link as the tracker's odometry
 //! ([`pushbot::exec::odometry_feed`], what `pushbot track --port` does), judged against the

@@ -222,7 +222,7 @@ impl Intrinsics {
     }
 }
 
-/// A typical webcam (issue 20: k1 = −0.08, f = 700 px) with some of every coefficient, for
+/// A typical webcam (k1 = −0.08, f = 700 px) with some of every coefficient, for
 /// this crate's tests.
 #[cfg(test)]
 pub(crate) fn test_webcam() -> Intrinsics {

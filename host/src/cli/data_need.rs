@@ -1,4 +1,4 @@
-//! `pushbot eval delivery --figure 7`: the data-need curve of issue 24 (samples collected vs
+//! `pushbot eval delivery --figure 7`: the data-need curve (samples collected vs
 //! success of Lau et al.'s deliveries), argument checks and printing around
 //! [`crate::experiments::data_need`].
 

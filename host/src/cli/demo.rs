@@ -56,28 +56,23 @@ pub struct DemoArgs {
     #[arg(long, requires = "port")]
     pub camera: Option<String>,
     /// Simulated seconds per wall second of the built-in target.
-    #[arg(long = "sim-speed", alias = "speed", default_value_t = 8.0)]
+    #[arg(long = "sim-speed", alias = "speed", default_value_t = 8.0, help_heading = super::ADVANCED)]
     pub speed: f64,
     /// Also render every figure as PNG.
     #[arg(long)]
     pub png: bool,
     /// Where collected pushing strategies are cached (default: OUT/cache).
-    #[arg(long)]
+    #[arg(long, help_heading = super::ADVANCED)]
     pub cache: Option<PathBuf>,
     /// Keep a live view while it runs: open OUT/live/live.html in a browser (the camera image
     /// with detected markers, tracked poses and the current path, refreshed after every look).
     #[arg(long)]
     pub view: bool,
-    /// Link faults between the host and the built-in simulated target (as `pushbot-sim`
-    /// takes them), e.g. `--faults --fault-cut-every 5 --fault-cut-for 1`.
-    #[cfg(feature = "sim")]
-    #[command(flatten)]
-    pub faults: crate::sim::target::FaultArgs,
     /// Move a box by hand mid-run on the built-in simulated target (repeatable):
     /// `AT:OBJECT:DX:DY[:DTHETA_DEG]`, e.g. `--disturb 40:b:0:0.1` moves box `b` 10 cm at 40 s
     /// of simulated time; the executor re-plans from where it is, and the report lists it.
     #[cfg(feature = "sim")]
-    #[arg(long, value_name = "AT:OBJECT:DX:DY")]
+    #[arg(long, value_name = "AT:OBJECT:DX:DY", help_heading = super::ADVANCED)]
     pub disturb: Vec<crate::sim::target::Disturbance>,
     /// Record the run into this MCAP file (default OUT/run.mcap): camera, detections, tracked
     /// poses, scene, paths, telemetry, logs, in Foxglove's schemas (open it in Foxglove, or
@@ -91,6 +86,12 @@ pub struct DemoArgs {
     /// goes (open Foxglove, "Open connection", ws://ADDR); ADDR defaults to 127.0.0.1:8765.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765", conflicts_with = "no_record")]
     pub foxglove: Option<String>,
+    /// Link faults between the host and the built-in simulated target (as `pushbot-sim`
+    /// takes them), e.g. `--faults --fault-cut-every 5 --fault-cut-for 1`; last, as their
+    /// heading holds for what follows.
+    #[cfg(feature = "sim")]
+    #[command(flatten, next_help_heading = "Fault injection")]
+    pub faults: crate::sim::target::FaultArgs,
 }
 
 /// The scene a stage runs on: `--scene STAGE=…` or the default.

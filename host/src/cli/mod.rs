@@ -42,26 +42,26 @@ pub enum SimCameraArg {
 #[derive(Args, Debug, Clone)]
 pub struct Global {
     /// Print one JSON object (or JSON lines for streams) instead of text.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, help_heading = GLOBAL)]
     pub json: bool,
     /// Seed for everything random (simulation noise, sampling).
-    #[arg(long, global = true, default_value_t = 1)]
+    #[arg(long, global = true, help_heading = GLOBAL, default_value_t = 1)]
     pub seed: u64,
     /// More log output (-v info, -vv debug, -vvv trace). Logs go to stderr.
-    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    #[arg(short, long, global = true, help_heading = GLOBAL, action = clap::ArgAction::Count)]
     pub verbose: u8,
     /// When the robot's serial port goes away (a USB re-enumeration), wait this many seconds of
     /// wall time for it to come back and go on; without it, a vanished port is an error at once.
-    #[arg(long, global = true, value_name = "SECONDS")]
+    #[arg(long, global = true, help_heading = GLOBAL, value_name = "SECONDS")]
     pub reconnect: Option<f64>,
     /// Do not recover a broken link (a cut, a vanished port): end the task with an error
     /// instead of reconnecting, clearing the link's fault and going on from the measured pose.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, help_heading = GLOBAL)]
     pub no_recover: bool,
     /// The camera's lens: a ROS `camera_info` or OpenCV `FileStorage` YAML file (intrinsics and
     /// `plumb_bob` distortion), for commands that use a camera; overrides the scene's
     /// `camera.intrinsics`.
-    #[arg(long, global = true, value_name = "FILE")]
+    #[arg(long, global = true, help_heading = GLOBAL, value_name = "FILE")]
     pub intrinsics: Option<std::path::PathBuf>,
 }
 
@@ -92,8 +92,27 @@ impl Global {
 }
 
 /// pushbot: a small differential-drive robot that rearranges and delivers objects by pushing.
+/// `pushbot --version`: the crate's version and the git revision it was built from
+/// (`host/build.rs`; `unknown` outside a git checkout).
+pub const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (",
+    env!("PUSHBOT_GIT_REVISION"),
+    ")"
+);
+
+/// The heading under which a command's research and tuning options stand in its `--help`,
+/// after the options a user needs.
+pub const ADVANCED: &str = "Advanced options";
+
+/// The heading of an evaluation's options for running on the robot rather than in simulation.
+pub const ROBOT: &str = "On the robot";
+
+/// The heading of the options every command takes.
+pub const GLOBAL: &str = "Global options";
+
 #[derive(Parser, Debug)]
-#[command(name = "pushbot", version, about, long_about = None)]
+#[command(name = "pushbot", version = VERSION, about, long_about = None)]
 pub struct Cli {
     #[command(flatten)]
     pub global: Global,

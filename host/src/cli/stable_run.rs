@@ -1,5 +1,5 @@
 //! `pushbot eval stable`: Lynch & Mason's stable pushes (§4) planned
-//! for the plated robot and driven closed loop (issue 21; [`crate::exec::stable_feedback`]) —
+//! for the plated robot and driven closed loop ([`crate::exec::stable_feedback`]) —
 //! or open loop, as the paper drives them, with `--open-loop` — on the in-process simulated
 //! robot, perturbed with `--perturb` (the scene's `[perturb]` ranges, seeded by `--seed` and
 //! the trial number); through a serial port and a camera with `--hil` (the built-in target on

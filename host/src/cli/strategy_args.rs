@@ -16,34 +16,34 @@ use crate::strategy::regression::{Admission, KernelParams};
 #[derive(Args, Debug, Clone)]
 pub struct SimArgs {
     /// Camera position noise (standard deviation), mm.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 1.0)]
     pub noise_mm: f64,
     /// Camera heading noise (standard deviation), degrees.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 0.5)]
     pub noise_deg: f64,
     /// How far inside the table edge the object's boundary lies, m [default: 0.1 in simulation,
     /// whose table gets --table-margin of extra room; 0.2 with --hil, where the table is the
     /// real one and the robot needs room to get behind an object at the boundary]
-    #[arg(long)]
+    #[arg(long, help_heading = super::ADVANCED)]
     pub boundary_inset: Option<f64>,
     /// Extra simulated table beyond the scene's on every side (room for the robot), m.
-    #[arg(long, default_value_t = 0.25)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 0.25)]
     pub table_margin: f64,
     /// Kernel width K_w of the regression, m (the paper: 8 px ≈ 1.8 cm).
-    #[arg(long, default_value_t = 0.018)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 0.018)]
     pub kernel_width: f64,
     /// Neighbours k of the regression.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 5)]
     pub k: usize,
     /// How much the special case (re-positioning) prefers pushes that turn the object little:
     /// metres of object motion a radian of turn weighs (0: the paper's motion alone).
-    #[arg(long, default_value_t = crate::strategy::regression::TURN_WEIGHT)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = crate::strategy::regression::TURN_WEIGHT)]
     pub turn_weight: f64,
     /// What the simulated robot sees the table with: `truth` (the simulator's poses with the
     /// noise above; fast) or `rendered` (frames rendered from the simulated world — lens,
     /// markers at their heights, blur, noise — read by the host's detector, calibration and
     /// tracker: the camera in the loop). `--figure 11` defaults to `rendered`.
-    #[arg(long, value_enum)]
+    #[arg(long, help_heading = super::ADVANCED, value_enum)]
     pub sim_camera: Option<super::SimCameraArg>,
 }
 
@@ -86,22 +86,22 @@ pub enum KeepArg {
     Informative,
 }
 
-/// How the collection chooses and keeps its pushes (issue 24: fewer samples to learn).
+/// How the collection chooses and keeps its pushes (fewer samples to learn than the paper).
 #[derive(Args, Debug, Clone)]
 pub struct ActiveArgs {
     /// How the initial collection chooses its pushes.
-    #[arg(long, value_enum, default_value_t = SelectionArg::Explore)]
+    #[arg(long, help_heading = super::ADVANCED, value_enum, default_value_t = SelectionArg::Explore)]
     pub selection: SelectionArg,
     /// Which pushes of the collection's evaluation are kept as samples.
-    #[arg(long, value_enum, default_value_t = KeepArg::Informative)]
+    #[arg(long, help_heading = super::ADVANCED, value_enum, default_value_t = KeepArg::Informative)]
     pub keep: KeepArg,
     /// With `--keep informative`: a push whose (p, s) lies farther than this from every sample
     /// is new, m [default: 0.01]
-    #[arg(long)]
+    #[arg(long, help_heading = super::ADVANCED)]
     pub novel_distance: Option<f64>,
     /// With `--keep informative`: a push whose robot motion differs by more than this from the
     /// strategy's answer at its (p, s) is a surprise, degrees [default: 20]
-    #[arg(long)]
+    #[arg(long, help_heading = super::ADVANCED)]
     pub surprise_deg: Option<f64>,
 }
 
@@ -151,13 +151,13 @@ pub struct CollectArgs {
     pub out: Option<PathBuf>,
     /// K: samples of the initial collection (the paper's collection: 300 with `--selection
     /// random --keep all`).
-    #[arg(long, default_value_t = DEFAULT_INITIAL)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = DEFAULT_INITIAL)]
     pub initial: usize,
     /// Stop the evaluation after this many straight successful queries.
     #[arg(long, default_value_t = 10)]
     pub streak: usize,
     /// Give up the evaluation after this many queries.
-    #[arg(long, default_value_t = 80)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 80)]
     pub max_queries: usize,
     /// Write the strategy as an SVG (Fig. 7 style).
     #[arg(long)]
@@ -191,7 +191,7 @@ pub struct EvalArgs {
 pub enum EvalCmd {
     /// Deliver the object from named start positions to the goal (Lau et al. Fig. 10–11).
     Delivery(Box<DeliveryArgs>),
-    /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds (issue 21).
+    /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds.
     Stable(super::stable_run::StableEvalArgs),
 }
 
@@ -212,7 +212,7 @@ pub struct DeliveryArgs {
     /// Learned delivery's boundary guard: the band inside the boundary where the wanted object
     /// motion is pulled inward and pushes are shortened, m; 0 is the paper's delivery, which
     /// only fails once the object crosses the boundary [default: 0.06]
-    #[arg(long)]
+    #[arg(long, help_heading = super::ADVANCED)]
     pub boundary_guard: Option<f64>,
     /// Scene preset or file (e.g. lau-irregular), several separated by commas, or `lau-all`
     /// for the six objects of Lau et al.; scenes with obstacles are delivered along a global
@@ -249,52 +249,52 @@ pub struct DeliveryArgs {
     #[arg(long)]
     pub strategy_dir: Option<PathBuf>,
     /// K of the collection when no strategy file is given.
-    #[arg(long, default_value_t = DEFAULT_INITIAL)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = DEFAULT_INITIAL)]
     pub initial: usize,
     /// Time limit of one trial, s of simulated time (the paper: 8 minutes).
-    #[arg(long, default_value_t = 480.0)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 480.0)]
     pub time_limit: f64,
     /// Run on the robot through the serial port and the camera (`--port`, `--camera`): collect
     /// (unless `--strategy`) and deliver the one live object from where it is to the goal,
     /// `--trials` times, with one `--method`.
-    #[arg(long)]
+    #[arg(long, help_heading = super::ROBOT)]
     pub hil: bool,
     /// With `--hil`: the robot's serial port.
-    #[arg(long)]
+    #[arg(long, help_heading = super::ROBOT)]
     pub port: Option<String>,
     /// With `--hil`: the camera (a device, an image folder, a video, or `sim:HOST:PORT`).
-    #[arg(long)]
+    #[arg(long, help_heading = super::ROBOT)]
     pub camera: Option<String>,
     /// With `--hil`: the robot's link watchdog, ms of robot time.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, help_heading = super::ROBOT, default_value_t = 1000)]
     pub watchdog_ms: u16,
     /// With `--hil`: record the run (camera, detections, tracked poses, telemetry) into this
     /// MCAP file, in Foxglove's schemas (`pushbot replay FILE` tracks it again).
-    #[arg(long, value_name = "FILE.mcap", requires = "hil")]
+    #[arg(long, help_heading = super::ROBOT, value_name = "FILE.mcap", requires = "hil")]
     pub record: Option<PathBuf>,
     /// Collection's evaluation stops after this many straight successful queries (0: initial
     /// collection only).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 10)]
     pub streak: usize,
     /// Write the first trial's trajectories of every start (Fig. 8 style) as an SVG, and a PNG
     /// of it beside; with `--figure`, the figure.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     /// With `--figure 7`: samples between the curve's points.
-    #[arg(long, default_value_t = 25)]
+    #[arg(long, help_heading = super::ADVANCED, default_value_t = 25)]
     pub every: usize,
     /// Keep every finished cell (scene × start × method) in this JSON-lines file as it is
     /// done; run again with the same file (the same --trials, --seed, camera and strategies;
     /// starts, methods or scenes may be added) and the cells already in it are not run again.
     /// For evaluations of hours: an interruption loses only the cells that were running. Example: `pushbot eval delivery --figure 11 --trials
     /// 50 --strategy-dir strategies --resume fig11-cells.jsonl`
-    #[arg(long, value_name = "FILE.jsonl", conflicts_with = "hil")]
+    #[arg(long, help_heading = super::ADVANCED, value_name = "FILE.jsonl", conflicts_with = "hil")]
     pub resume: Option<PathBuf>,
     /// Write every trial run into this folder: `SCENE-START-METHOD-TRIAL.json` (how it went,
     /// the robot's and the object's pose after every step) and an SVG drawing of it (tracks,
     /// the object's outline along the way, the stalls recovered). Example: `pushbot eval
     /// delivery --scene lau-zigzag-l --method learned --trials 20 --trace-dir traces`
-    #[arg(long, value_name = "DIR", conflicts_with = "hil")]
+    #[arg(long, help_heading = super::ADVANCED, value_name = "DIR", conflicts_with = "hil")]
     pub trace_dir: Option<PathBuf>,
     #[command(flatten)]
     pub active: ActiveArgs,

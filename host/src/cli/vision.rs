@@ -32,10 +32,10 @@ pub struct CameraArgs {
     #[arg(long)]
     pub layout: Option<PathBuf>,
     /// Frame rate assumed for image folders without time sidecars.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, help_heading = super::ADVANCED)]
     pub fps: f64,
     /// Marker detector.
-    #[arg(long, value_enum, default_value = "apriltag-c")]
+    #[arg(long, value_enum, default_value = "apriltag-c", help_heading = super::ADVANCED)]
     pub detector: DetectorKind,
 }
 
@@ -68,7 +68,7 @@ pub struct TrackArgs {
     pub frames: Option<usize>,
     /// Search every whole frame for markers instead of regions around the tracked markers
     /// (whole frames then come only every 15 frames and whenever a body is missed).
-    #[arg(long)]
+    #[arg(long, help_heading = super::ADVANCED)]
     pub whole_frames: bool,
     /// Record the frames, detections and tracked poses into this MCAP file (Foxglove schemas;
     /// `pushbot replay FILE` tracks them again).

@@ -16,7 +16,7 @@
 //! collection with an error that says where the object is, after [`STUCK_RESETS`] tries. The
 //! collection ends with the object inside the boundary.
 //!
-//! Fewer samples than the paper (issue 24): each push of the initial collection is, by default,
+//! Fewer samples than the paper: each push of the initial collection is, by default,
 //! the one of [`CollectParams::candidates`] random pushes that, with the contact it leads the
 //! robot to, the strategy knows least ([`Selection::Explore`], [`crate::strategy::active`]), and
 //! the initial collection ends with a push for each way of moving the object (every 45°) its
@@ -69,7 +69,7 @@ pub struct CollectParams {
     pub admission: Option<Admission>,
 }
 
-/// K of the initial collection by default: measured (issue 24) as the shortest that reaches
+/// K of the initial collection by default: measured as the shortest that reaches
 /// the streak within 300 samples on every `lau-*` object.
 pub const DEFAULT_INITIAL: usize = 100;
 

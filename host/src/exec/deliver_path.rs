@@ -223,7 +223,7 @@ const MIN_SIDE_STEP: f64 = 0.02;
 
 /// How far a recovery pushes the marker aside when it is `to_goal` from the goal, m. Half the
 /// way at most: the nudge and the way back to where it stalled are the path it adds, and beside
-/// the goal a push as long as the way left (session 34's rule) took the L-shape past the goal
+/// the goal a push as long as the way left took the L-shape past the goal
 /// and back, 1.53–1.64× its shortest path in the zigzag's pocket (1.41–1.44× at half).
 fn side_step_reach(to_goal: f64) -> f64 {
     SIDE_STEP.min(0.5 * to_goal).max(MIN_SIDE_STEP)

@@ -1,4 +1,4 @@
-//! The robot's telemetry as the tracker's odometry (issue 20): every telemetry report the link
+//! The robot's telemetry as the tracker's odometry: every telemetry report the link
 //! delivers carries the robot's wheel odometry and its own clock; the feed hands each one to the
 //! vision pipeline on the camera's clock ([`crate::vision::Pipeline::odometry`]), so the tracker
 //! predicts the robot's motion between frames from its wheels rather than from its last velocity.

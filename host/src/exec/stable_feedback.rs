@@ -1,4 +1,4 @@
-//! Closed-loop stable pushing (issue 21) on the plated robot: the plan of Lynch & Mason §4
+//! Closed-loop stable pushing on the plated robot: the plan of Lynch & Mason §4
 //! driven with the camera in the loop. §3's guarantee — the slider stays fixed on the pusher —
 //! holds for *every* pusher motion whose rotation centre lies in the stable set of the contact
 //! (§3.3, STABLE), not only for the planner's extremal controls. So the robot may steer freely

@@ -1,4 +1,4 @@
-//! Re-planning from measured poses for the closed loop of issue 21
+//! Re-planning from measured poses for the closed loop of stable pushing
 //! ([`crate::exec::stable_feedback`]): Lynch & Mason's planner (§4.1–4.5) run again from where
 //! the camera sees the slider, as its plans assume a known start. Three things the planner
 //! alone does not give an executor: plans that keep a margin from the obstacles where they can

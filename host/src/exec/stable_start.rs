@@ -1,5 +1,5 @@
-//! The transit to the first pushing contact from wherever the robot starts (issue 21: "transit
-//! for any start orientation"). Lynch & Mason §4.6 leave the transit between contacts open;
+//! The transit to the first pushing contact from wherever the robot starts, at any
+//! heading. Lynch & Mason §4.6 leave the transit between contacts open;
 //! [`crate::planner::stable::transit`] plans it for the robot's turning disk, and this is the
 //! same from a free start pose of any heading instead of from a contact: a shortest path of the
 //! turning disk among the obstacles and the slider to the stand-off in front of the first

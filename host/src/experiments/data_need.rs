@@ -1,4 +1,4 @@
-//! The data-need curve (issue 24, `eval delivery --figure 7`): how many samples Lau, Mitani &
+//! The data-need curve (`eval delivery --figure 7`): how many samples Lau, Mitani &
 //! Igarashi's Algorithm 1 (§III-C initial collection, §III-D experimental evaluation) needs
 //! before the learned delivery (§III-E, Algorithm 2) succeeds, for the paper's collection and
 //! for the active one ([`crate::strategy::active`], [`crate::strategy::regression::Admission`]).

@@ -1,4 +1,4 @@
-//! The data-need figure (`eval delivery --figure 7`, issue 24): one panel per object, success %
+//! The data-need figure (`eval delivery --figure 7`): one panel per object, success %
 //! of the test deliveries (y) against samples in the strategy (x), one line per collection
 //! [`super::data_need::Variant`], a dashed mark where each reached Lau et al.'s 10-streak
 //! (§III-D), and the 300-sample budget.

@@ -7,7 +7,7 @@
 //! 2. **rearrange** (Ben-Shahar & Rivlin): plan an optimal rearrangement of two boxes (cost map
 //!    and restoration) and execute it, re-observing and snapping to the grid;
 //! 3. **stable** (Lynch & Mason): plan stable pushes of the slider among obstacles and drive
-//!    them closed loop (the camera watching every push; issue 21).
+//!    them closed loop (the camera watching every push).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -514,7 +514,7 @@ fn stage_stable(ctx: &mut Ctx<'_>, name: &str) -> Result<StageReport> {
     let mut st = StageReport::new(
         "stable",
         &format!("Stable pushing of the slider among obstacles ({name}), closed loop"),
-        "Lynch & Mason §3 (STABLE), §4 (planner); closed loop inside the stable set (issue 21)",
+        "Lynch & Mason §3 (STABLE), §4 (planner); closed loop inside the stable set",
     );
     let pb = ctx.bar("stable");
     pb.set_message("planning stable pushes for the plated robot");

@@ -7,7 +7,7 @@
 //!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
 //! - `fig11`: Lau et al. Fig. 11's table and figure from those trials.
 //! - `data_need`, `data_need_figure`: samples collected vs delivery success, for the paper's
-//!   collection and the active one (issue 24, `eval delivery --figure 7`).
+//!   collection and the active one (`eval delivery --figure 7`).
 //! - `resume`: the file of finished cells that lets such an evaluation be interrupted and
 //!   resumed (`eval delivery --resume`).
 //! - `trace`: every trial's poses and a drawing of it (`eval delivery --trace-dir`).
@@ -16,7 +16,7 @@
 //! - [`rearrange_bench`]: the exact cost map and the practical mode of the rearrangement
 //!   planner on large rooms (`pushbot bench rearrange`).
 //! - `stable_trials`: stable pushing (Lynch & Mason §4) open and closed loop in perturbed
-//!   simulated worlds (`pushbot run stable`, `pushbot eval stable`; issue 21).
+//!   simulated worlds (`pushbot run stable`, `pushbot eval stable`).
 //! - `link_bench`: commands through a faulty wire to the in-process target (`pushbot bench
 //!   link`).
 

@@ -1,4 +1,4 @@
-//! Stable-pushing trials in perturbed simulated worlds (issue 21): Lynch & Mason's plan (§4)
+//! Stable-pushing trials in perturbed simulated worlds: Lynch & Mason's plan (§4)
 //! for the plated robot, made with the nominal model, driven open loop
 //! ([`crate::exec::stable::execute`]) or closed loop
 //! ([`crate::exec::stable_feedback::execute_closed_loop`]) on the in-process simulated robot

@@ -49,8 +49,8 @@ pub struct StartResult {
     pub failures: BTreeMap<String, usize>,
     /// Stalls recovered from (or given up on) over all trials (deliveries among obstacles).
     pub stall_recoveries: usize,
-    /// Trials that ran out of time without a recovery attempt logged (issue 24 asks for none
-    /// among obstacles; on the clear table there is no recovery to log).
+    /// Trials that ran out of time without a recovery attempt logged (among obstacles there
+    /// should be none; on the clear table there is no recovery to log).
     pub silent_timeouts: usize,
 }
 

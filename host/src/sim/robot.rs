@@ -129,8 +129,8 @@ impl SimRobot {
         SimRobot::perturbed(scene, object_id, start, opts, None)
     }
 
-    /// As [`SimRobot::new`], in the perturbed world `perturb` (issue 21,
-    /// `sim-target/src/perturb.rs`): the simulated world runs its start error, frictions, centre of
+    /// As [`SimRobot::new`], in the perturbed world `perturb`
+    /// (`sim-target/src/perturb.rs`): the simulated world runs its start error, frictions, centre of
     /// friction and wheel slip; the camera noise stays `opts`'s.
     pub fn perturbed(
         mut scene: Scene,

@@ -34,7 +34,7 @@ pub struct Calibration {
     pub markers: Vec<u32>,
     /// Number of point pairs.
     pub points: usize,
-    /// The lens the corners were undistorted through before the fit (issue 20): the pipeline
+    /// The lens the corners were undistorted through before the fit: the pipeline
     /// measures through the same lens. `None`: an ideal pinhole (raw corners).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lens: Option<pushbot_world::lens::Intrinsics>,

@@ -1,4 +1,4 @@
-//! The robot's odometry as the tracker's control input (issue 20): between two frames the robot's
+//! The robot's odometry as the tracker's control input: between two frames the robot's
 //! own wheel odometry says how it moved — a spin at 360°/s or a dash whose marker the camera sees
 //! only as a smear — so the filter predicts that motion instead of extrapolating its last
 //! velocity. The increment `Δ = odom(t₀)⁻¹ ∘ odom(t₁)` (robot frame, interpolated between

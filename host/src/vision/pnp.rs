@@ -1,5 +1,5 @@
 //! The camera's pose over the table from the calibration markers through a known lens — the
-//! perspective-n-point problem on a plane (issue 20): started from the homography's
+//! perspective-n-point problem on a plane: started from the homography's
 //! decomposition (Zhang 2000, §3.1, [`CameraPose::from_homography`]), the six pose parameters
 //! (a rotation vector and a translation) minimise the reprojection error of every marker corner
 //! through the whole lens, distortion included, against the corners as detected, by

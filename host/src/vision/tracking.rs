@@ -6,7 +6,7 @@
 //! been rejected several frames running (it really moved: the filter restarts there). Every
 //! pose carries the time of the frame it is for and the age of its last accepted detection.
 //!
-//! A body the filter can no longer place is **lost** (issue 20): no accepted detection for
+//! A body the filter can no longer place is **lost**: no accepted detection for
 //! [`TrackerParams::lost_after`], or for long enough that a body accelerating at
 //! [`TrackerParams::max_accel`] could have strayed [`TrackerParams::lost_drift`] from the
 //! prediction (two frames at 30 fps with the defaults: a robot that starts to drive fast, its marker smeared, is

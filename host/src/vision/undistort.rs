@@ -1,5 +1,5 @@
 //! Undistortion where it is needed: the detected marker corners and centres, not the whole
-//! image (issue 20, item 6). A detection's points go through the lens's inverse
+//! image. A detection's points go through the lens's inverse
 //! ([`pushbot_world::lens::Intrinsics::undistort_pixel`]) into the ideal pinhole image, where
 //! the table is a plane seen through a homography again and the calibration and measurement
 //! hold as for an ideal camera. Detections stay in raw pixels for drawing and for the regions

@@ -68,7 +68,7 @@ pub struct Hardware {
     /// uniformly from ±`slip_noise` (small random slip that averages out).
     pub slip_noise: f64,
     /// Each wheel's systematic rim-speed error over the ground (share; left, right): a slip
-    /// the encoders cannot see, which makes the robot veer (issue 21's perturbed worlds).
+    /// the encoders cannot see, which makes the robot veer (perturbed worlds).
     pub wheel_slip: [f64; 2],
     /// Probability that one encoder reading is off by ±1 count.
     pub encoder_jitter: f64,

@@ -1,5 +1,5 @@
 //! The optional `[perturb]` section of a scene: how far the simulated world may differ from the
-//! model the planner uses (issue 21; Lynch & Mason §4 plan with nominal friction and a known
+//! model the planner uses (Lynch & Mason §4 plan with nominal friction and a known
 //! start, and their stable pushes promise only that the slider stays on the pusher). Ranges
 //! only: `pushbot_sim::perturb` draws one world from them per trial; every field is optional
 //! and defaults to the value shown.
@@ -44,7 +44,7 @@ pub struct Perturb {
 }
 
 impl Default for Perturb {
-    /// Issue 21's ranges: ±5°, ±10 mm, friction ±30 %, 5 mm centre of friction, ±0.5 % wheel
+    /// The default ranges: ±5°, ±10 mm, friction ±30 %, 5 mm centre of friction, ±0.5 % wheel
     /// slip, a camera with 1 mm and 0.5° of noise.
     fn default() -> Self {
         Perturb {

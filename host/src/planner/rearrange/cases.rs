@@ -73,7 +73,7 @@ pub fn problem_from_toml(text: &str, file: &str) -> Result<Problem, SceneError> 
         return Err(SceneError(format!(
             "{file}: not a scene: it has no [table] section (the shared scene format needs \
              [table], and [rearrange] for the grid planner; the old grid format with `map`, \
-             [robot] at and [[movable]] is no longer read: see the README's Scenes section)"
+             [robot] at and [[movable]] is no longer read: see docs/src/scenes.md)"
         )));
     }
     let scene = Scene::from_toml(text, file).map_err(|e| SceneError(e.to_string()))?;

@@ -4,7 +4,7 @@
 //! regions as in the paper (±25 % / ±10 % of the slider length, ±2°). The slider is shaped after
 //! Fig. 12: a box with one corner cut, pushed on two opposite edges.
 //!
-//! Every scene is one of the shared format (`pushbot_world::Scene`, issue 4) with a `[stable]`
+//! Every scene is one of the shared format (`pushbot_world::Scene`) with a `[stable]`
 //! section (`pushbot_world::scene::stable`), read through [`from_shared`] into the planner's own
 //! description ([`Scene`]): the presets, and scene files (which need a `[table]`).
 
@@ -163,8 +163,8 @@ pub fn scene_from_toml(text: &str, file: &str) -> anyhow::Result<Scene> {
         bail!(
             "{file}: not a scene: it has no [table] section (the shared scene format needs \
              [table], and [stable] for the stable-pushing planner; the old stable-only format \
-             with `table = [w, h]`, [task] and [pusher] is no longer read: see the README's \
-             Scenes section)"
+             with `table = [w, h]`, [task] and [pusher] is no longer read: see \
+             docs/src/scenes.md)"
         );
     }
     let (shared, notes) =
