@@ -6,9 +6,9 @@
 //! (no plan even on the table without its obstacles), or every reachable configuration
 //! explored, with the closest approach to the goal and what blocks the pushes there.
 //!
-//! Each reason is decided from the search's own trace ([`SearchTrace`]) and from collision
-//! tests against the scene's obstacles one at a time, so the obstacles it names are the ones
-//! the pushes actually meet.
+//! Each reason is decided from the search's own trace ([`super::search::SearchTrace`]) and
+//! from collision tests against the scene's obstacles one at a time, so the obstacles it names
+//! are the ones the pushes actually meet.
 
 use std::fmt;
 
