@@ -36,6 +36,7 @@ fn serve(peer: Peer, mut master: TTYPort, stop: &AtomicBool) {
     let mut buf = [0u8; 512];
     let mut dec = FrameDecoder::new();
     let _ = master.set_timeout(Duration::from_millis(10));
+    let (t0, mut sent) = (Instant::now(), 0u64);
     while !stop.load(Ordering::Relaxed) {
         // Until the host opens its end (and after it closed it) a read fails: keep going.
         let n = match master.read(&mut buf) {
@@ -47,8 +48,13 @@ fn serve(peer: Peer, mut master: TTYPort, stop: &AtomicBool) {
         };
         let out: Vec<u8> = match peer {
             Peer::Silence => Vec::new(),
-            // 100 bytes every 10 ms: about a line at 115 200 baud.
-            Peer::Garbage => (0..100).map(|_| rng.random()).collect(),
+            // 5 000 bytes a second by the clock: a device on a serial line, well below a flood.
+            Peer::Garbage => {
+                let due = (t0.elapsed().as_secs_f64() * 5000.0) as u64;
+                let n = due.saturating_sub(sent);
+                sent += n;
+                (0..n).map(|_| rng.random()).collect()
+            }
             Peer::Zeros => vec![0; 100],
             Peer::Flood => (0..4096).map(|_| rng.random()).collect(),
             Peer::Echo => buf[..n].to_vec(),
