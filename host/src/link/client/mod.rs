@@ -44,8 +44,12 @@ use pushbot_protocol::{
     Command, ContactEvent, Done, HostFrame, NackReason, PROTOCOL_VERSION, RobotMsg, Telemetry,
 };
 
+mod heard;
 mod types;
 mod wire;
+
+use heard::Listened;
+pub use heard::heartbeat_due;
 
 pub use types::{
     Answer, ClientOptions, Event, Handshake, Heard, HostTime, LinkStats, MotionEnd, RobotEvent,
@@ -64,16 +68,6 @@ pub const NOISY_FOR: Duration = Duration::from_secs(5);
 const ECHO_FRAMES: usize = 8;
 /// A flood: more bytes per second than a serial line at 115 200 baud can carry.
 pub const FLOOD_BYTES_PER_S: f64 = 11_520.0;
-
-/// What arrived since the handshake began (see [`Heard`]).
-#[derive(Debug, Clone, Copy, Default)]
-struct Listened {
-    since: HostTime,
-    bytes: u64,
-    zeros: u64,
-    echoes: u64,
-    frames: u64,
-}
 
 /// A command sent and not yet answered.
 #[derive(Debug, Clone, Copy)]
@@ -133,24 +127,6 @@ pub struct Client {
     /// The latest frames sent (without delimiters), kept until a robot frame arrives: an echo
     /// of them is not the robot talking.
     sent_frames: VecDeque<Vec<u8>>,
-}
-
-/// Whether a heartbeat is due: a quarter watchdog period of robot time since the last frame
-/// sent (by the telemetry), or of host time (for a robot that sends no telemetry), or the robot
-/// clock went backwards (it restarted).
-pub fn heartbeat_due(
-    robot_now_us: Option<u64>,
-    last_tx_robot_us: Option<u64>,
-    since_tx_host: Duration,
-    watchdog_ms: u16,
-) -> bool {
-    let period_us = u64::from(watchdog_ms) * 1000 / 4;
-    let by_robot_time = match (robot_now_us, last_tx_robot_us) {
-        (Some(now), Some(last)) => now < last || now - last >= period_us,
-        (Some(_), None) => true,
-        (None, _) => false,
-    };
-    by_robot_time || since_tx_host >= Duration::from_micros(period_us)
 }
 
 impl Client {
@@ -419,67 +395,6 @@ impl Client {
             self.dead_reported = true;
             self.events.push_back(Event::LinkDead { silent });
         }
-    }
-
-    /// Whether the frame the reader just completed is one of the host's own, come back.
-    fn is_echo(&self) -> bool {
-        let frame = self.reader.last_frame();
-        !frame.is_empty() && self.sent_frames.iter().any(|s| s.as_slice() == frame)
-    }
-
-    /// What arrived since the latest `Hello`, at `now`.
-    fn heard(&self, now: HostTime) -> Heard {
-        let l = self.listened;
-        if l.bytes == 0 {
-            Heard::Nothing
-        } else if l.frames > 0 {
-            Heard::Frames { frames: l.frames }
-        } else if l.echoes > 0 {
-            Heard::Echo { bytes: l.bytes }
-        } else if l.zeros == l.bytes {
-            Heard::Zeros { bytes: l.bytes }
-        } else {
-            Heard::Garbage {
-                bytes: l.bytes,
-                secs: now.since(l.since).as_secs_f64(),
-            }
-        }
-    }
-
-    /// Whether the wire counts as noisy at `now`.
-    pub fn noisy(&self, now: HostTime) -> bool {
-        self.noisy_until.is_some_and(|t| now < t)
-    }
-
-    fn mark_noisy(&mut self, now: HostTime) {
-        self.noisy_until = Some(now.after(NOISY_FOR));
-    }
-
-    /// The watchdog period heartbeats are paced for at `now`: half the real one on a noisy wire.
-    fn paced_watchdog_ms(&self, now: HostTime) -> u16 {
-        if self.noisy(now) {
-            (self.watchdog_ms / 2).max(1)
-        } else {
-            self.watchdog_ms
-        }
-    }
-
-    fn heartbeat_if_due(&mut self, now: HostTime) {
-        if self.heartbeats_paused
-            || !heartbeat_due(
-                self.telemetry.map(|t| t.time_us),
-                self.last_tx_robot_us,
-                now.since(self.last_tx),
-                self.paced_watchdog_ms(now),
-            )
-        {
-            return;
-        }
-        let frame = HostFrame {
-            seq: self.heartbeat_seq,
-            cmd: Command::Heartbeat,
-        };
-        self.send_frame(now, &frame);
     }
 
     fn answer(&mut self, seq: u16, answer: Answer) {
