@@ -660,3 +660,39 @@ fn a_noisy_wire_tightens_the_policy() {
     }
     assert_eq!(sends, 10);
 }
+
+#[test]
+fn the_emergency_stop_goes_ahead_of_a_command_in_flight_which_is_never_resent() {
+    let (mut c, mut fw) = connected();
+    let drive = Command::Velocity {
+        v: 0.1,
+        omega: 0.0,
+        timeout_ms: 500,
+    };
+    let a = c.motion(ms(2), drive, 1_000_000);
+    sent(&mut c, ms(2)); // on the wire, unanswered (the answer is lost)
+    let b = c.command(ms(3), Command::ClearFaults); // queued, not yet written
+    let e = c.emergency_stop(ms(4));
+    let (bytes, frames) = sent(&mut c, ms(4));
+    assert_eq!(
+        frames,
+        [HostFrame {
+            seq: e,
+            cmd: Command::EmergencyStop
+        }]
+    );
+    assert_eq!(c.take_answer(a), Some(Answer::Preempted));
+    assert_eq!(c.take_answer(b), Some(Answer::Preempted));
+    c.handle_bytes(ms(5), &fw.exchange(&bytes));
+    assert!(matches!(c.take_answer(e), Some(Answer::Ack { .. })));
+    // Past every ack timeout: nothing withdrawn goes out again.
+    c.handle_timeout(ms(2000));
+    let (_, later) = sent(&mut c, ms(2000));
+    assert!(later.iter().all(|f| f.seq != a && f.seq != b), "{later:?}");
+    for k in 0..100 {
+        let out = fw.exchange(&[]);
+        c.handle_bytes(ms(2001 + k), &out);
+    }
+    let t = c.telemetry().expect("telemetry");
+    assert!(t.faults.contains(pushbot_protocol::Faults::EMERGENCY_STOP) && t.active.is_none());
+}

@@ -29,8 +29,8 @@ use std::sync::{Mutex, MutexGuard};
 use std::time::Duration;
 
 use pushbot_protocol::{
-    Command, ConfigUpdate, ContactEvent, Faults, FirmwareVersion, Geometry, HelloReply, Mode, Pose,
-    Telemetry,
+    Command, ConfigUpdate, ContactEvent, Faults, FirmwareVersion, Geometry, HelloReply, Mode,
+    NackReason, Pose, Telemetry,
 };
 
 use crate::link::{
@@ -144,6 +144,12 @@ impl<D: Driver> Robot<D> {
             Answer::Nack(reason) => Err(LinkError::Refused {
                 what,
                 reason: Refusal(reason),
+            }),
+            // Withdrawn for the emergency stop sent ahead of it: the robot, stopped, would
+            // refuse it now.
+            Answer::Preempted => Err(LinkError::Refused {
+                what,
+                reason: Refusal(NackReason::Faulted(Faults::EMERGENCY_STOP)),
             }),
             Answer::GaveUp { attempts } => Err(LinkError::NoAnswer {
                 path: self.path().to_string(),
@@ -315,8 +321,11 @@ impl<D: Driver> Robot<D> {
     }
 
     /// Cut the motors at once and latch `EMERGENCY_STOP`; returns the telemetry that shows it.
+    /// It does not wait for a command in flight: that one is withdrawn (and ends refused for
+    /// the emergency stop), and the stop is written ahead of anything still queued.
     pub fn emergency_stop(&self) -> Result<Telemetry, LinkError> {
-        let (_, at) = self.request(Command::EmergencyStop)?;
+        let seq = self.driver.with_client(|c, now| c.emergency_stop(now))?;
+        let (_, at) = self.answered(seq, "EmergencyStop")?;
         self.wait_telemetry_where(at, 2_000_000, "EmergencyStop", |t| {
             t.faults.contains(Faults::EMERGENCY_STOP)
         })

@@ -23,6 +23,7 @@
 //! | replies matched by number: duplicates and late replies ignored, any order | [`Client::handle_bytes`] |
 //! | a motion's end: its `Done`, or read from the telemetry when the `Done` was lost, or its budget of robot time spent | [`Client::motion`], [`Client::take_motion_end`] |
 //! | heartbeats paced by robot time, with a host-time fallback | [`Client::handle_bytes`], [`Client::handle_timeout`] |
+//! | the emergency stop ahead of any command in flight, which is withdrawn, never resent | [`Client::emergency_stop`] |
 //! | a dead link (no byte for `dead_link_timeout` of host time) | [`Client::link_dead`], [`Event::LinkDead`] |
 //!
 //! `now` is the driver's monotonic host time ([`HostTime`]): wall time since the port opened
@@ -44,6 +45,7 @@ use pushbot_protocol::{
     Command, ContactEvent, Done, HostFrame, NackReason, PROTOCOL_VERSION, RobotMsg, Telemetry,
 };
 
+mod estop;
 mod heard;
 mod types;
 mod wire;
@@ -239,7 +241,6 @@ impl Client {
     }
 
     fn start(&mut self, now: HostTime, frame: HostFrame, max: u32) {
-        self.answers.clear();
         self.heartbeat_seq = frame.seq;
         self.send_frame(now, &frame);
         self.pending.push(Pending {

@@ -189,6 +189,8 @@ pub enum Answer {
     },
     /// Refused.
     Nack(NackReason),
+    /// Withdrawn unanswered by [`super::Client::emergency_stop`], which went ahead of it.
+    Preempted,
     /// Never answered.
     GaveUp {
         /// How many times it was sent.
