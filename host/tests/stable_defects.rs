@@ -316,3 +316,28 @@ fn d6_concave_slider_contact_is_the_true_contact() {
         );
     }
 }
+
+/// A file in the old stable-only format is named as such; a scene with a typo gets the
+/// parser's own message, not the old format's.
+#[test]
+fn the_old_format_is_told_apart_from_a_scene_that_does_not_parse() {
+    let old = "table = [1.0, 1.0]\n[task]\nstart = [0.1, 0.1, 0.0]\n";
+    let e = scene_from_toml(old, "old.toml").unwrap_err().to_string();
+    assert!(e.contains("old.toml") && e.contains("no [table]"), "{e}");
+    let good = scene(
+        1.2,
+        1.0,
+        "",
+        SLIDER,
+        [0.3, 0.5, 0.0],
+        [0.9, 0.5, 0.0],
+        "edges = [0]\npusher = { kind = \"arm\" }",
+    );
+    scene_from_toml(&good, "good.toml").unwrap();
+    let typo = good.replace("goal_xy_frac", "goal_xy_frak");
+    let e = scene_from_toml(&typo, "typo.toml").unwrap_err().to_string();
+    assert!(
+        !e.contains("no [table]") && e.contains("goal_xy_frak"),
+        "{e}"
+    );
+}

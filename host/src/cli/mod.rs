@@ -14,6 +14,8 @@ pub mod console;
 #[cfg(feature = "sim")]
 mod data_need;
 pub mod demo;
+#[cfg(feature = "sim")]
+mod eval_merge;
 pub mod lens;
 pub mod link_bench;
 pub mod rearrange;

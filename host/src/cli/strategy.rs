@@ -21,6 +21,9 @@ use crate::strategy::store;
 
 /// Run `pushbot eval`.
 pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
+    if let EvalCmd::Merge(m) = &a.cmd {
+        return merge(global, m);
+    }
     let EvalCmd::Delivery(a) = a.cmd else {
         return Err(CliError::bad_input(
             "pushbot eval: not a delivery evaluation",
@@ -44,6 +47,17 @@ pub fn run_eval(global: &Global, a: EvalArgs) -> CliResult {
         return run_hil(global, &a, &scene);
     }
     eval_in_sim(global, a)
+}
+
+/// `pushbot eval merge`.
+#[cfg(feature = "sim")]
+fn merge(global: &Global, a: &super::strategy_args::MergeArgs) -> CliResult {
+    super::eval_merge::merge(global, a)
+}
+
+#[cfg(not(feature = "sim"))]
+fn merge(_global: &Global, _a: &super::strategy_args::MergeArgs) -> CliResult {
+    Err(super::no_simulated_target())
 }
 
 /// `pushbot eval delivery` in the in-process simulation.

@@ -193,6 +193,24 @@ pub enum EvalCmd {
     Delivery(Box<DeliveryArgs>),
     /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds.
     Stable(super::stable_run::StableEvalArgs),
+    /// Join the files of a sweep's shards (`--shard K/N --resume FILE`) into the one table and
+    /// figure, as the sweep run whole prints them.
+    #[command(
+        after_help = "Example:\n  pushbot eval merge fig11-1.jsonl fig11-2.jsonl fig11-3.jsonl --svg fig11.svg"
+    )]
+    Merge(MergeArgs),
+}
+
+/// `pushbot eval merge`.
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The shards' files, one per shard (in any order).
+    #[arg(required = true, value_name = "FILE.jsonl")]
+    pub files: Vec<PathBuf>,
+    /// Where to draw the figure (default: `fig11.svg` for a `--figure 11` sweep; none for
+    /// others, whose one scene's trajectories it draws when given).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
 }
 
 /// Which delivery methods to run.
@@ -290,6 +308,12 @@ pub struct DeliveryArgs {
     /// 50 --strategy-dir strategies --resume fig11-cells.jsonl`
     #[arg(long, help_heading = super::ADVANCED, value_name = "FILE.jsonl", conflicts_with = "hil")]
     pub resume: Option<PathBuf>,
+    /// Run only the K-th of N shares of the sweep's cells (dealt the same way on every
+    /// machine), into its own --resume file; `pushbot eval merge` joins the N files into the
+    /// one table and figure. Example: `pushbot eval delivery --figure 11 --trials 50
+    /// --strategy-dir strategies --shard 2/3 --resume fig11-2.jsonl`
+    #[arg(long, help_heading = super::ADVANCED, value_name = "K/N", requires = "resume")]
+    pub shard: Option<crate::experiments::shard::Shard>,
     /// Write every trial run into this folder: `SCENE-START-METHOD-TRIAL.json` (how it went,
     /// the robot's and the object's pose after every step) and an SVG drawing of it (tracks,
     /// the object's outline along the way, the stalls recovered). Example: `pushbot eval

@@ -14,14 +14,13 @@ use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::exec::deliver::Delivery;
 use crate::experiments::delivery::collect_or_load;
-use crate::experiments::fig11::{fig11_svg, fig11_table};
 use crate::experiments::resume::{CellRecord, Checkpoint, RunKey, SceneKey};
+use crate::experiments::shard::Sweep;
 use crate::experiments::strategy_eval::{
-    LAU_SCENES, LabelledRun, Method, SceneEval, StartResult, TrialSetup, evaluate_scene,
+    LAU_SCENES, LabelledRun, Method, SceneEval, StartResult, TrialSetup, evaluate_cells,
     parse_starts,
 };
 use crate::experiments::trace::TraceDir;
-use crate::planner::global::scene_goal;
 use crate::sim::robot::{SimCamera, SimRobot, SimRobotOptions};
 use crate::strategy::figures;
 use crate::strategy::regression::{KernelParams, PushStrategy};
@@ -331,9 +330,20 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
         .zip(&strategies)
         .map(|(setup, (samples, _))| SceneKey::new(setup, samples))
         .collect();
+    let sweep = a.shard.map(|shard| Sweep {
+        shard,
+        scenes: names.clone(),
+        starts: starts.clone(),
+        methods: methods.clone(),
+        figure: a.figure,
+        object: a.object.clone(),
+    });
     let checkpoint = match &a.resume {
         Some(path) => {
-            let key = RunKey::new(a.trials, global.seed, camera_name);
+            let mut key = RunKey::new(a.trials, global.seed, camera_name);
+            if let Some(sw) = &sweep {
+                key = key.sharded(sw.clone());
+            }
             let c = Checkpoint::open(path, &key, &scene_keys).map_err(CliError::BadInput)?;
             if c.cells() > 0 && !global.json {
                 println!(
@@ -350,11 +360,27 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
         Some(dir) => Some(TraceDir::create(dir).map_err(CliError::BadInput)?),
         None => None,
     };
-    let total = (setups.len() * starts.len() * methods.len() * a.trials) as u64;
+    // This run's cells of each scene: all of them, or its shard's share.
+    let mine: Vec<Vec<(String, Method)>> = (0..setups.len())
+        .map(|si| {
+            let mut cells = Vec::new();
+            for (ti, s) in starts.iter().enumerate() {
+                for (mi, m) in methods.iter().enumerate() {
+                    if sweep.as_ref().is_none_or(|sw| sw.owns(si, ti, mi)) {
+                        cells.push((s.clone(), *m));
+                    }
+                }
+            }
+            cells
+        })
+        .collect();
+    let total = (mine.iter().map(Vec::len).sum::<usize>() * a.trials) as u64;
     let pb = progress_bar(global, total);
     let mut evals = Vec::new();
     let mut trajectories = Vec::new();
-    for ((setup, (samples, collection)), key) in setups.iter().zip(strategies).zip(&scene_keys) {
+    for (((setup, (samples, collection)), key), cells) in
+        setups.iter().zip(strategies).zip(&scene_keys).zip(&mine)
+    {
         let scene = &setup.scene;
         let resumed = |start: &str, method: Method| {
             let c = checkpoint.as_ref()?.cell(&scene.name, start, method)?;
@@ -410,9 +436,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
             }
             Ok(())
         };
-        let (results, runs) = evaluate_scene(
-            setup, &methods, &samples, &starts, a.trials, &resumed, &report,
-        )?;
+        let (results, runs) = evaluate_cells(setup, cells, &samples, a.trials, &resumed, &report)?;
         if !several {
             trajectories.extend(runs);
         }
@@ -424,59 +448,21 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
         });
     }
     pb.finish_and_clear();
-    let camera = match a.sim.sim_camera {
-        Some(SimCameraArg::Rendered) => "the rendered camera in the loop",
-        _ => "the simulator's poses with camera noise",
-    };
-    if let Some(svg) = &a.svg {
-        let text = if a.figure.is_some() {
-            let caption = format!(
-                "{} trials per bar, seed {}, {camera}; `pushbot eval delivery --figure 11 --trials {} --seed {}`",
-                a.trials, global.seed, a.trials, global.seed
-            );
-            fig11_svg(&evals, &starts, &methods, &caption)
-        } else {
-            let scene = &setups[0].scene;
-            let goal = scene_goal(scene, a.object.as_deref()).map_err(CliError::BadInput)?;
-            figures::trajectories_svg(&trajectories, scene, goal)
-        };
-        std::fs::write(svg, &text)
-            .map_err(|e| CliError::Failed(anyhow::anyhow!("writing {}: {e}", svg.display())))?;
-        crate::plot::svg_to_png(&text, &svg.with_extension("png")).map_err(CliError::Failed)?;
-    }
-    let learned_ok = evals
-        .iter()
-        .flat_map(|e| &e.results)
-        .filter(|r| r.method == Method::Learned)
-        .all(|r| r.success_rate >= 95.0);
-    if global.json {
-        println!(
-            "{}",
-            json!({
-                "trials": a.trials,
-                "starts": starts,
-                "camera": camera_name,
-                "figure": a.svg.as_ref().filter(|_| a.figure.is_some()),
-                "scenes": evals,
-            })
-        );
-    } else {
-        println!(
-            "\nSuccess % of {} trials (Lau et al. Fig. 11), {camera}:",
-            a.trials
-        );
-        print!("{}", fig11_table(&evals, &starts, &methods));
-        if let (Some(_), Some(svg)) = (a.figure, &a.svg) {
-            println!(
-                "figure written to {} and {}",
-                svg.display(),
-                svg.with_extension("png").display()
-            );
-        }
-    }
-    Ok(if learned_ok {
-        Status::Success
-    } else {
-        Status::TaskFailed
-    })
+    let scene = (!several).then(|| (&setups[0].scene, a.object.as_deref()));
+    super::eval_merge::show(
+        global,
+        super::eval_merge::SweepEnd {
+            trials: a.trials,
+            seed: global.seed,
+            camera: camera_name,
+            starts: &starts,
+            methods: &methods,
+            figure: a.figure,
+            svg: a.svg.clone(),
+            evals,
+            trajectories,
+            scene,
+            shard: sweep.map(|sw| (sw.shard, mine.iter().map(Vec::len).sum())),
+        },
+    )
 }

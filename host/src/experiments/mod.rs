@@ -10,6 +10,8 @@
 //!   collection and the active one (`eval delivery --figure 7`).
 //! - `resume`: the file of finished cells that lets such an evaluation be interrupted and
 //!   resumed (`eval delivery --resume`).
+//! - [`shard`]: the K-th of N shares of a sweep's cells (`--shard K/N`), and the sweep each
+//!   shard's file names for `eval merge`.
 //! - `trace`: every trial's poses and a drawing of it (`eval delivery --trace-dir`).
 //! - `delivery`: collect (or reuse) a strategy, then deliver among obstacles (§III-E).
 //! - `demo`: the demo's three stages, one per paper, into a report.
@@ -35,6 +37,7 @@ pub mod link_bench;
 pub mod rearrange_bench;
 #[cfg(feature = "sim")]
 pub mod resume;
+pub mod shard;
 #[cfg(feature = "sim")]
 pub mod stable_trials;
 #[cfg(feature = "sim")]

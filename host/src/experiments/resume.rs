@@ -21,6 +21,7 @@ use std::sync::Mutex;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 
+use super::shard::Sweep;
 use super::strategy_eval::{LabelledRun, Method, StartResult, TrialSetup};
 use crate::strategy::sample::Sample;
 
@@ -64,6 +65,9 @@ pub struct RunKey {
     pub seed: u64,
     /// `truth` or `rendered`.
     pub camera: String,
+    /// The sweep and its share, for a shard's file (`--shard`); `None` for a whole run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<Sweep>,
 }
 
 impl RunKey {
@@ -74,12 +78,21 @@ impl RunKey {
             trials,
             seed,
             camera: camera.to_owned(),
+            sweep: None,
+        }
+    }
+
+    /// The key of a shard's run: its sweep and share.
+    pub fn sharded(self, sweep: Sweep) -> RunKey {
+        RunKey {
+            sweep: Some(sweep),
+            ..self
         }
     }
 
     /// What differs between this run and `file`'s, in words.
-    fn differences(&self, file: &RunKey) -> Vec<String> {
-        [
+    pub fn differences(&self, file: &RunKey) -> Vec<String> {
+        let mut out: Vec<String> = [
             ("format", self.format.to_string(), file.format.to_string()),
             ("trials", self.trials.to_string(), file.trials.to_string()),
             ("seed", self.seed.to_string(), file.seed.to_string()),
@@ -88,13 +101,20 @@ impl RunKey {
         .into_iter()
         .filter(|(_, a, b)| a != b)
         .map(|(name, a, b)| format!("{name} {b} in the file, {a} now"))
-        .collect()
+        .collect();
+        match (&self.sweep, &file.sweep) {
+            (Some(a), Some(b)) => out.extend(a.differences(b)),
+            (Some(a), None) => out.push(format!("a whole run in the file, shard {} now", a.shard)),
+            (None, Some(b)) => out.push(format!("shard {} in the file, a whole run now", b.shard)),
+            (None, None) => {}
+        }
+        out
     }
 }
 
 impl SceneKey {
     /// What differs between this scene and `file`'s, in words.
-    fn differences(&self, file: &SceneKey) -> Vec<String> {
+    pub fn differences(&self, file: &SceneKey) -> Vec<String> {
         let mut out = Vec::new();
         if self.setup_crc != file.setup_crc {
             out.push(format!(
@@ -131,29 +151,75 @@ pub struct Checkpoint {
     file: Mutex<std::fs::File>,
 }
 
+/// A file's header and its whole cells, read without changing it.
+#[derive(Debug)]
+pub struct FileCells {
+    /// The run's key (line 1).
+    pub header: RunKey,
+    /// Every whole cell, with its line number (from 1).
+    pub cells: Vec<(usize, CellRecord)>,
+    /// Bytes up to the end of the last whole line (a last line cut short is not counted).
+    pub keep: usize,
+}
+
+impl FileCells {
+    /// Read the file at `path`: `None` when there is none or it is empty. A last line cut
+    /// short (an interrupted run) is dropped; any other line that does not read is an error
+    /// naming it.
+    pub fn read(path: &Path) -> Result<Option<FileCells>> {
+        let shown = path.display();
+        let text = match std::fs::read(path) {
+            Ok(bytes) => String::from_utf8(bytes)
+                .map_err(|_| anyhow::anyhow!("{shown} is not a text file of pushbot's"))?,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(e).with_context(|| format!("reading {shown}")),
+        };
+        if text.is_empty() {
+            return Ok(None);
+        }
+        let lines: Vec<&str> = text.split_inclusive('\n').collect();
+        let header: RunKey = serde_json::from_str(lines[0].trim_end()).with_context(|| {
+            format!("{shown} line 1 is not the header of a `pushbot eval delivery --resume` file")
+        })?;
+        // A header without its newline was cut short before any cell: it is written again.
+        let mut keep = if lines[0].ends_with('\n') {
+            lines[0].len()
+        } else {
+            0
+        };
+        let mut cells = Vec::new();
+        for (i, line) in lines.iter().enumerate().skip(1) {
+            if i + 1 == lines.len() && !line.ends_with('\n') {
+                tracing::warn!(
+                    "{shown}: its last line was cut short (an interrupted run); that cell runs again"
+                );
+                break;
+            }
+            let c: CellRecord = serde_json::from_str(line.trim_end())
+                .with_context(|| format!("{shown} line {}", i + 1))?;
+            keep += line.len();
+            cells.push((i + 1, c));
+        }
+        Ok(Some(FileCells {
+            header,
+            cells,
+            keep,
+        }))
+    }
+}
+
 impl Checkpoint {
     /// Open (or start) the file of run `key` at `path`, reading back the cells it holds of
     /// `scenes` (the cells of other scenes stay in the file, unused).
     pub fn open(path: &Path, key: &RunKey, scenes: &[SceneKey]) -> Result<Checkpoint> {
         let shown = path.display();
-        let text = match std::fs::read(path) {
-            Ok(bytes) => String::from_utf8(bytes)
-                .map_err(|_| anyhow::anyhow!("{shown} is not a text file of pushbot's"))?,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-            Err(e) => return Err(e).with_context(|| format!("reading {shown}")),
-        };
+        let read = FileCells::read(path)?;
         let mut done = HashMap::new();
         // Bytes up to the end of the last complete line.
         let mut keep = 0;
-        if !text.is_empty() {
-            let lines: Vec<&str> = text.split_inclusive('\n').collect();
-            let header: RunKey = serde_json::from_str(lines[0].trim_end()).with_context(|| {
-                format!(
-                    "{shown} line 1 is not the header of a `pushbot eval delivery --resume` file"
-                )
-            })?;
-            if &header != key {
-                let what = key.differences(&header);
+        if let Some(read) = read {
+            if &read.header != key {
+                let what = key.differences(&read.header);
                 bail!(
                     "{shown} holds the cells of another run ({}): pass another file, or delete \
                      it to start over",
@@ -164,31 +230,16 @@ impl Checkpoint {
                     }
                 );
             }
-            // A header without its newline was cut short before any cell: it is written again.
-            keep = if lines[0].ends_with('\n') {
-                lines[0].len()
-            } else {
-                0
-            };
-            for (i, line) in lines.iter().enumerate().skip(1) {
-                if i + 1 == lines.len() && !line.ends_with('\n') {
-                    tracing::warn!(
-                        "{shown}: its last line was cut short (an interrupted run); that cell runs again"
-                    );
-                    break;
-                }
-                let c: CellRecord = serde_json::from_str(line.trim_end())
-                    .with_context(|| format!("{shown} line {}", i + 1))?;
-                keep += line.len();
+            keep = read.keep;
+            for (line, c) in read.cells {
                 let Some(now) = scenes.iter().find(|s| s.scene == c.scene.scene) else {
                     continue;
                 };
                 let what = now.differences(&c.scene);
                 if !what.is_empty() {
                     bail!(
-                        "{shown} line {}: its cell was run with another {}: pass another file, \
-                         or delete it to start over",
-                        i + 1,
+                        "{shown} line {line}: its cell was run with another {}: pass another \
+                         file, or delete it to start over",
                         what.join("; ")
                     );
                 }

@@ -228,11 +228,24 @@ pub fn evaluate_scene(
     resumed: &ResumedCells<'_>,
     report: &CellReport<'_>,
 ) -> Result<(Vec<StartResult>, Vec<LabelledRun>)> {
-    use rayon::prelude::*;
-    let cells: Vec<(&String, Method)> = starts
+    let cells: Vec<(String, Method)> = starts
         .iter()
-        .flat_map(|s| methods.iter().map(move |m| (s, *m)))
+        .flat_map(|s| methods.iter().map(move |m| (s.clone(), *m)))
         .collect();
+    evaluate_cells(setup, &cells, samples, trials, resumed, report)
+}
+
+/// As [`evaluate_scene`], for the given cells (start × method) only, in their order (one
+/// shard's share of a sweep, [`super::shard`]).
+pub fn evaluate_cells(
+    setup: &TrialSetup,
+    cells: &[(String, Method)],
+    samples: &[Sample],
+    trials: usize,
+    resumed: &ResumedCells<'_>,
+    report: &CellReport<'_>,
+) -> Result<(Vec<StartResult>, Vec<LabelledRun>)> {
+    use rayon::prelude::*;
     let done = cells
         .par_iter()
         .map(|(s, m)| {

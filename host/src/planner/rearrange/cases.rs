@@ -67,16 +67,21 @@ pub fn preset_name(name: &str) -> Option<&'static str> {
 /// The grid problem of a scene's TOML text (the shared format with a `[rearrange]` section);
 /// `file` names the source in errors, which give its line and field.
 pub fn problem_from_toml(text: &str, file: &str) -> Result<Problem, SceneError> {
-    if let Ok(t) = toml::from_str::<toml::Table>(text)
-        && !t.get("table").is_some_and(|v| v.is_table())
-    {
-        return Err(SceneError(format!(
-            "{file}: not a scene: it has no [table] section (the shared scene format needs \
-             [table], and [rearrange] for the grid planner; the old grid format with `map`, \
-             [robot] at and [[movable]] is no longer read: see docs/src/scenes.md)"
-        )));
-    }
-    let scene = Scene::from_toml(text, file).map_err(|e| SceneError(e.to_string()))?;
+    // Parsed once (a fine outline makes a scene file large); the old format is told apart
+    // only when the scene does not parse.
+    let scene = Scene::from_toml(text, file).map_err(|e| {
+        if toml::from_str::<toml::Table>(text)
+            .is_ok_and(|t| !t.get("table").is_some_and(|v| v.is_table()))
+        {
+            SceneError(format!(
+                "{file}: not a scene: it has no [table] section (the shared scene format needs \
+                 [table], and [rearrange] for the grid planner; the old grid format with `map`, \
+                 [robot] at and [[movable]] is no longer read: see docs/src/scenes.md)"
+            ))
+        } else {
+            SceneError(e.to_string())
+        }
+    })?;
     super::scene::problem_from_scene(&scene, Some(text), file)
         .map_err(|e| SceneError(e.to_string()))
 }

@@ -157,18 +157,23 @@ pub const PAPER_SECONDS: [f64; 5] = [7.0, 1.0, 35.0, 2.0, 43.0];
 /// The stable-pushing task of a scene's TOML text (the shared format with a `[stable]`
 /// section); `file` names the source in errors, which give its line and field.
 pub fn scene_from_toml(text: &str, file: &str) -> anyhow::Result<Scene> {
-    if let Ok(t) = text.parse::<toml::Table>()
-        && !t.get("table").is_some_and(|v| v.is_table())
-    {
-        bail!(
-            "{file}: not a scene: it has no [table] section (the shared scene format needs \
-             [table], and [stable] for the stable-pushing planner; the old stable-only format \
-             with `table = [w, h]`, [task] and [pusher] is no longer read: see \
-             docs/src/scenes.md)"
-        );
-    }
-    let (shared, notes) =
-        pushbot_world::Scene::from_toml_noted(text, file).map_err(|e| anyhow!("{e}"))?;
+    // Parsed once (a fine outline makes a scene file large); the old format is told apart
+    // only when the scene does not parse.
+    let (shared, notes) = pushbot_world::Scene::from_toml_noted(text, file).map_err(|e| {
+        if text
+            .parse::<toml::Table>()
+            .is_ok_and(|t| !t.get("table").is_some_and(|v| v.is_table()))
+        {
+            anyhow!(
+                "{file}: not a scene: it has no [table] section (the shared scene format needs \
+                 [table], and [stable] for the stable-pushing planner; the old stable-only \
+                 format with `table = [w, h]`, [task] and [pusher] is no longer read: see \
+                 docs/src/scenes.md)"
+            )
+        } else {
+            anyhow!("{e}")
+        }
+    })?;
     let mut s = from_shared(&shared).with_context(|| format!("scene file {file}"))?;
     let object = shared.objects.iter().position(|o| o.id == s.task.object);
     s.outline_reversed = object.is_some_and(|i| {
