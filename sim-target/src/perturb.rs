@@ -19,7 +19,7 @@ use crate::scene::perturb::Perturb;
 use crate::scene::{Scene, Support};
 
 /// The values one perturbed world runs.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Perturbation {
     /// The object it applies to (the pushed one).
     pub object: String,

@@ -4,7 +4,7 @@
 //! the merge refuses what is not one whole sweep.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 use serde_json::Value;
 
@@ -146,4 +146,92 @@ fn three_shards_merged_equal_the_sweep_run_whole() {
     let e = err(again);
     assert!(e.contains("shard 1/3 in the file, 2/3 now"), "{e}");
     assert_eq!(std::fs::read(&files[0]).unwrap(), before);
+}
+
+/// `pushbot eval stable` spread over three shards at once: the merge equals the evaluation run
+/// whole, trial for trial, for one scene in perturbed worlds and for random scenes; a shard
+/// run again with its file runs nothing again.
+#[test]
+fn stable_trials_in_three_shards_merge_into_the_whole_evaluation() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    for (what, args, rows) in [
+        (
+            "fig15",
+            &["--scene", "fig15", "--perturb", "--trials", "7"][..],
+            "trials",
+        ),
+        (
+            "random",
+            &["--random", "8", "--pusher", "car"][..],
+            "scenes",
+        ),
+    ] {
+        let stable = |extra: &[&str]| {
+            let mut c = Command::new(pushbot_tests::bin("pushbot"));
+            c.args(["--json", "eval", "stable"]).args(args).args(extra);
+            c
+        };
+        let files: Vec<PathBuf> = (1..=3).map(|k| p(&format!("{what}-{k}.jsonl"))).collect();
+        let shards: Vec<_> = (1..=3)
+            .map(|k| {
+                stable(&["--shard", &format!("{k}/3"), "--resume"])
+                    .arg(&files[k - 1])
+                    .stdout(Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        let whole = json(&stable(&[]).output().unwrap());
+        let mut counts = Vec::new();
+        for s in shards {
+            let out = s.wait_with_output().unwrap();
+            let v = json(&out);
+            assert!(v["summary"]["shard"].is_string(), "{v}");
+            counts.push(v[rows].as_array().unwrap().len());
+        }
+        assert_eq!(
+            counts.iter().sum::<usize>(),
+            whole[rows].as_array().unwrap().len()
+        );
+        assert!(counts.iter().all(|&c| c >= 2), "{what}: {counts:?}");
+        let out = Command::new(pushbot_tests::bin("pushbot"))
+            .args(["--json", "eval", "merge"])
+            .args(files.iter().rev())
+            .output()
+            .unwrap();
+        let merged = json(&out);
+        assert_eq!(
+            merged[rows], whole[rows],
+            "{what}: the merge equals the whole run"
+        );
+        for k in ["reached", "trials", "seed", "perturbed", "closed_loop"] {
+            assert_eq!(merged["summary"][k], whole["summary"][k], "{what}: {k}");
+        }
+        // Run again with its file, a shard finds every trial done and prints the same.
+        let before = std::fs::read(&files[1]).unwrap();
+        let again = stable(&["--shard", "2/3", "--resume"])
+            .arg(&files[1])
+            .output()
+            .unwrap();
+        assert!(
+            String::from_utf8_lossy(&again.stderr).contains("not run again"),
+            "{}",
+            String::from_utf8_lossy(&again.stderr)
+        );
+        assert_eq!(
+            std::fs::read(&files[1]).unwrap(),
+            before,
+            "nothing appended"
+        );
+        // A shard's file given twice does not merge.
+        let e = Command::new(pushbot_tests::bin("pushbot"))
+            .args(["eval", "merge"])
+            .arg(&files[0])
+            .arg(&files[0])
+            .output()
+            .unwrap();
+        assert_eq!(e.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&e.stderr).contains("both shard 1/3"));
+    }
 }

@@ -119,6 +119,16 @@ pub(super) fn show(global: &Global, end: SweepEnd<'_>) -> CliResult {
 /// `pushbot eval merge FILES…`: every shard of one sweep, once each, each cell of the sweep
 /// in one of them; the table and figure as the sweep run whole prints them.
 pub(super) fn merge(global: &Global, a: &MergeArgs) -> CliResult {
+    let first = a
+        .files
+        .first()
+        .ok_or_else(|| CliError::bad_input("no file given"))?;
+    let header = std::fs::read_to_string(first)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(t.lines().next()?).ok());
+    if header.is_some_and(|h| h["eval"] == "stable") {
+        return merge_stable(global, a);
+    }
     let mut key: Option<(RunKey, Sweep, String)> = None;
     let mut seen: HashMap<usize, String> = HashMap::new();
     let mut cells: HashMap<(String, String, Method), (CellRecord, String)> = HashMap::new();
@@ -278,4 +288,89 @@ pub(super) fn merge(global: &Global, a: &MergeArgs) -> CliResult {
 /// name, or the name inside a scene file.
 fn scene_of(arg: &str) -> String {
     Scene::preset_or_file(arg).map_or_else(|_| arg.to_owned(), |s| s.name)
+}
+
+/// `pushbot eval merge` of a stable evaluation's shards (`eval stable --shard K/N --resume`).
+fn merge_stable(global: &Global, a: &MergeArgs) -> CliResult {
+    use std::collections::BTreeMap;
+
+    use crate::experiments::stable_sweep::{self, StableKey, TrialRecord};
+    use crate::experiments::stable_trials::StableTask;
+    let mut first: Option<(StableKey, Shard, String)> = None;
+    let mut seen: HashMap<usize, String> = HashMap::new();
+    let mut trials: BTreeMap<u64, TrialRecord> = BTreeMap::new();
+    for path in &a.files {
+        let shown = path.display().to_string();
+        let (key, recs, _) = stable_sweep::read(path)
+            .map_err(|e| CliError::bad_input(format!("{e:#}")))?
+            .ok_or_else(|| CliError::bad_input(format!("{shown}: no such file, or empty")))?;
+        let Some(shard) = key.shard else {
+            return Err(CliError::bad_input(format!(
+                "{shown} is the file of a whole run, not of a shard (`--shard K/N`): there is \
+                 nothing to merge it with"
+            )));
+        };
+        let whole = StableKey { shard: None, ..key };
+        match &first {
+            None => first = Some((whole, shard, shown.clone())),
+            Some((k, s, f)) => {
+                let mut what = k.differences(&whole);
+                if shard.n != s.n {
+                    what.push(format!("{} shards in {shown}, {} in {f}", shard.n, s.n));
+                }
+                if !what.is_empty() {
+                    return Err(CliError::bad_input(format!(
+                        "{shown} is a shard of another evaluation than {f} ({}): merge the files \
+                         of one evaluation",
+                        what.join("; ").replace(" now", &format!(" in {f}"))
+                    )));
+                }
+            }
+        }
+        if let Some(other) = seen.insert(shard.k, shown.clone()) {
+            return Err(CliError::bad_input(format!(
+                "{shown} and {other} are both shard {shard}: give each shard's file once"
+            )));
+        }
+        trials.extend(recs);
+    }
+    let Some((key, shard, _)) = first else {
+        return Err(CliError::bad_input("no file given"));
+    };
+    let missing: Vec<String> = (1..=shard.n)
+        .filter(|k| !seen.contains_key(k))
+        .map(|k| format!("{k}/{}", shard.n))
+        .collect();
+    if !missing.is_empty() {
+        return Err(CliError::bad_input(format!(
+            "shard {} of the evaluation not given: merge every shard's file",
+            missing.join(", ")
+        )));
+    }
+    let all = key.all_trials();
+    let missing: Vec<String> = all
+        .iter()
+        .filter(|t| !trials.contains_key(t))
+        .map(u64::to_string)
+        .collect();
+    if !missing.is_empty() {
+        return Err(CliError::bad_input(format!(
+            "{} of the evaluation's {} trials are in no file (trials {}); run those shards \
+             again with their --resume files, then merge",
+            missing.len(),
+            all.len(),
+            missing.join(", ")
+        )));
+    }
+    match &key.scene {
+        Some(name) => {
+            let task = StableTask::load(name).map_err(|e| CliError::bad_input(format!("{e:#}")))?;
+            let rows: Vec<_> = all.iter().filter_map(|t| trials[t].run.clone()).collect();
+            super::stable_run::show_named(global, &key, &task, &rows, false)
+        }
+        None => {
+            let rows: Vec<_> = all.iter().map(|t| (*t, trials[t].run.clone())).collect();
+            super::stable_run::show_random(global, &key, &rows)
+        }
+    }
 }

@@ -75,6 +75,66 @@ pub struct StableEvalArgs {
     /// turning radius).
     #[arg(long, default_value = "diff-drive", requires = "random")]
     pub pusher: String,
+    /// Keep every finished trial in this JSON-lines file as it is done; run again with the same
+    /// file (and the same arguments) and the trials in it are not run again.
+    #[arg(long, help_heading = super::ADVANCED, value_name = "FILE.jsonl", conflicts_with_all = ["hil", "port"])]
+    pub resume: Option<std::path::PathBuf>,
+    /// Run only the K-th of N shares of the trials, into its own --resume file; `pushbot eval
+    /// merge` joins the N files. Example: `pushbot eval stable --scene fig15 --perturb
+    /// --trials 300 --shard 1/3 --resume fig15-1.jsonl`
+    #[arg(long, help_heading = super::ADVANCED, value_name = "K/N", requires = "resume")]
+    pub shard: Option<crate::experiments::shard::Shard>,
+}
+
+impl StableEvalArgs {
+    /// The key of this run's trials (`scene` or random scenes of `pusher`, `count` of them).
+    #[cfg(feature = "sim")]
+    fn key(
+        &self,
+        g: &Global,
+        scene: Option<String>,
+        pusher: Option<String>,
+        count: u64,
+    ) -> crate::experiments::stable_sweep::StableKey {
+        let r = &self.run;
+        let camera = match r.sim_camera {
+            Some(super::SimCameraArg::Rendered) => "rendered",
+            _ => "truth",
+        };
+        let mut key = crate::experiments::stable_sweep::StableKey::new(
+            scene,
+            pusher,
+            !r.open_loop,
+            r.perturb,
+            g.seed,
+            r.trial,
+            count,
+            camera,
+        );
+        key.shard = self.shard;
+        key
+    }
+
+    /// The `--resume` file, opened for `key`.
+    #[cfg(feature = "sim")]
+    fn open(
+        &self,
+        key: &crate::experiments::stable_sweep::StableKey,
+    ) -> Result<Option<crate::experiments::stable_sweep::StableFile>, CliError> {
+        let Some(path) = &self.resume else {
+            return Ok(None);
+        };
+        let f = crate::experiments::stable_sweep::StableFile::open(path, key)
+            .map_err(|e| CliError::bad_input(format!("{e:#}")))?;
+        if !f.is_empty() {
+            eprintln!(
+                "{}: {} trials done in an earlier run, not run again",
+                path.display(),
+                f.len()
+            );
+        }
+        Ok(Some(f))
+    }
 }
 
 impl StableRunArgs {
@@ -135,11 +195,9 @@ pub fn eval(g: &Global, a: &StableEvalArgs) -> CliResult {
 
 #[cfg(feature = "sim")]
 fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
-    use rayon::prelude::*;
-    use serde_json::json;
-
-    use super::Status;
+    use crate::experiments::stable_sweep::TrialRecord;
     use crate::experiments::stable_trials::{StableTask, StableTrial, run_trial, run_trial_live};
+    use rayon::prelude::*;
     let r = &a.run;
     r.check()?;
     let Some(name) = &r.scene else {
@@ -153,7 +211,9 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
         crate::exec::grabber::FrameGrabber::open(camera, 30.0)
             .map_err(|e| CliError::bad_input(format!("--camera {camera}: {e}")))?;
     }
-    let trials: Vec<u64> = (r.trial..r.trial + a.trials).collect();
+    let key = a.key(g, Some(name.clone()), None, a.trials);
+    let file = a.open(&key)?;
+    let trials = key.mine();
     let pb = super::progress_bar(g, trials.len() as u64);
     pb.set_message(format!(
         "{} {} loop{}",
@@ -162,6 +222,14 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
         if r.perturb { ", perturbed" } else { "" }
     ));
     let one = |t: u64| -> anyhow::Result<StableTrial> {
+        if let Some(run) = file
+            .as_ref()
+            .and_then(|f| f.get(t))
+            .and_then(|d| d.run.clone())
+        {
+            pb.inc(1);
+            return Ok(run);
+        }
         let pert = task.perturbation(g.seed, t, r.perturb);
         let out = if r.hil || r.port.is_some() {
             let robot = r.port.as_deref().zip(r.camera.as_deref());
@@ -169,6 +237,12 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
         } else {
             run_trial(&task, t, g.seed, pert, !r.open_loop, r.sim_camera())
         };
+        if let (Some(f), Ok(run)) = (&file, &out) {
+            f.record(&TrialRecord {
+                trial: t,
+                run: Some(run.clone()),
+            })?;
+        }
         pb.inc(1);
         out
     };
@@ -185,14 +259,34 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
     if let Some(dir) = &r.svg {
         write_svgs(dir, &task, &rows)?;
     }
+    show_named(g, &key, &task, &rows, single)
+}
+
+/// The end of an evaluation of one scene (run whole, a shard's share, or the shards merged):
+/// the table or `--json`; `run` (`single`) fails when the goal was missed.
+#[cfg(feature = "sim")]
+pub(super) fn show_named(
+    g: &Global,
+    key: &crate::experiments::stable_sweep::StableKey,
+    task: &crate::experiments::stable_trials::StableTask,
+    rows: &[crate::experiments::stable_trials::StableTrial],
+    single: bool,
+) -> CliResult {
+    use serde_json::json;
+
+    use super::Status;
+    use crate::experiments::stable_trials::StableTrial;
+    let name = key.scene.as_deref().unwrap_or_default();
+    let (open_loop, perturb) = (!key.closed_loop, key.perturbed);
     let reached = rows.iter().filter(|t| t.reached).count();
     let n = rows.len();
     let mean = |f: &dyn Fn(&StableTrial) -> f64| rows.iter().map(f).sum::<f64>() / n as f64;
     let summary = json!({
         "scene": name,
-        "closed_loop": !r.open_loop,
-        "perturbed": r.perturb,
-        "seed": g.seed,
+        "closed_loop": !open_loop,
+        "perturbed": perturb,
+        "seed": key.seed,
+        "shard": key.shard.map(|s| s.to_string()),
         "trials": n,
         "reached": reached,
         "plan_pushes": task.plan.pushes,
@@ -208,14 +302,14 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
         println!(
             "{} ({} loop{}, seed {}): goal ±{:.0} mm, ±{:.1}°",
             name,
-            if r.open_loop { "open" } else { "closed" },
-            if r.perturb { ", perturbed" } else { "" },
-            g.seed,
+            if open_loop { "open" } else { "closed" },
+            if perturb { ", perturbed" } else { "" },
+            key.seed,
             task.problem.params.goal_xy * 1e3,
             task.problem.params.goal_theta.to_degrees()
         );
         println!("trial  reached  error mm   error °  re-plans  contact losses");
-        for t in &rows {
+        for t in rows {
             println!("{:5}  {}", t.trial, trial_row(t));
         }
         println!(
@@ -223,6 +317,13 @@ fn eval_or_run(g: &Global, a: &StableEvalArgs, single: bool) -> CliResult {
             mean(&|t| t.final_error_m * 1e3),
             mean(&|t| t.replans as f64)
         );
+        if let Some(s) = key.shard {
+            println!(
+                "shard {s}: {n} of the {} trials; join the shards' files with `pushbot eval \
+                 merge`",
+                key.trials
+            );
+        }
     }
     // `run` fails when the goal was missed; `eval` reports its numbers either way.
     let ok = !single || reached == n;
@@ -265,12 +366,9 @@ fn eval_or_run(_g: &Global, a: &StableEvalArgs, _single: bool) -> CliResult {
 /// what the run did, and the share reached of all scenes and of those with a plan.
 #[cfg(feature = "sim")]
 fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
-    use rayon::prelude::*;
-    use serde_json::json;
-
-    use super::Status;
     use crate::experiments::stable_trials::{StableTask, StableTrial, run_trial, run_trial_live};
     use crate::planner::stable::random_scene::RandomPusher;
+    use rayon::prelude::*;
     let r = &a.run;
     r.check()?;
     if r.port.is_some() {
@@ -285,10 +383,16 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
             a.pusher
         )));
     }
-    let seeds: Vec<u64> = (r.trial..r.trial + n).collect();
+    let key = a.key(g, None, Some(pusher.name().to_owned()), n);
+    let file = a.open(&key)?;
+    let seeds = key.mine();
     let pb = super::progress_bar(g, seeds.len() as u64);
     pb.set_message(format!("random {} scenes", pusher.name()));
     let one = |seed: u64| -> anyhow::Result<(u64, Option<StableTrial>)> {
+        if let Some(done) = file.as_ref().and_then(|f| f.get(seed)) {
+            pb.inc(1);
+            return Ok((seed, done.run.clone()));
+        }
         let out = match StableTask::random(seed, pusher)? {
             None => None,
             Some(task) => {
@@ -300,6 +404,12 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
                 })
             }
         };
+        if let Some(f) = &file {
+            f.record(&crate::experiments::stable_sweep::TrialRecord {
+                trial: seed,
+                run: out.clone(),
+            })?;
+        }
         pb.inc(1);
         Ok((seed, out))
     };
@@ -313,6 +423,20 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
     for (s, res) in seeds.iter().zip(results) {
         rows.push(res.map_err(|e| CliError::Failed(e.context(format!("random scene {s}"))))?);
     }
+    show_random(g, &key, &rows)
+}
+
+/// The end of an evaluation of random scenes (run whole, a shard's share, or the shards
+/// merged): per scene whether a plan exists and what the run did.
+#[cfg(feature = "sim")]
+pub(super) fn show_random(
+    g: &Global,
+    key: &crate::experiments::stable_sweep::StableKey,
+    rows: &[(u64, Option<crate::experiments::stable_trials::StableTrial>)],
+) -> CliResult {
+    use serde_json::json;
+
+    use super::Status;
     let planned = rows.iter().filter(|(_, t)| t.is_some()).count();
     let reached = rows
         .iter()
@@ -320,11 +444,12 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
         .count();
     let share = |k: usize, of: usize| if of == 0 { 0.0 } else { k as f64 / of as f64 };
     let summary = json!({
-        "random": n,
-        "pusher": pusher.name(),
-        "closed_loop": !r.open_loop,
-        "perturbed": r.perturb,
-        "seed": g.seed,
+        "random": key.trials,
+        "pusher": key.pusher,
+        "closed_loop": key.closed_loop,
+        "perturbed": key.perturbed,
+        "seed": key.seed,
+        "shard": key.shard.map(|s| s.to_string()),
         "trials": rows.len(),
         "planned": planned,
         "reached": reached,
@@ -341,15 +466,15 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
     } else {
         println!(
             "random {} scenes {}…{} ({} loop{}, seed {})",
-            pusher.name(),
-            r.trial,
-            r.trial + n - 1,
-            if r.open_loop { "open" } else { "closed" },
-            if r.perturb { ", perturbed" } else { "" },
-            g.seed
+            key.pusher.as_deref().unwrap_or_default(),
+            key.first_trial,
+            key.first_trial + key.trials - 1,
+            if key.closed_loop { "closed" } else { "open" },
+            if key.perturbed { ", perturbed" } else { "" },
+            key.seed
         );
         println!("scene  plan  reached  error mm   error °  re-plans  contact losses");
-        for (s, t) in &rows {
+        for (s, t) in rows {
             match t {
                 None => println!("{s:5}  none"),
                 Some(t) => println!("{s:5}  yes   {}", trial_row(t)),
@@ -362,6 +487,14 @@ fn eval_random(g: &Global, a: &StableEvalArgs, n: u64) -> CliResult {
             100.0 * share(reached, rows.len()),
             100.0 * share(reached, planned)
         );
+        if let Some(s) = key.shard {
+            println!(
+                "shard {s}: {} of the {} scenes; join the shards' files with `pushbot eval \
+                 merge`",
+                rows.len(),
+                key.trials
+            );
+        }
     }
     Ok(Status::Success)
 }

@@ -193,8 +193,8 @@ pub enum EvalCmd {
     Delivery(Box<DeliveryArgs>),
     /// Stable pushes (Lynch & Mason §4) closed or open loop in perturbed worlds.
     Stable(super::stable_run::StableEvalArgs),
-    /// Join the files of a sweep's shards (`--shard K/N --resume FILE`) into the one table and
-    /// figure, as the sweep run whole prints them.
+    /// Join the files of a sweep's shards (`eval delivery` or `eval stable` with `--shard K/N
+    /// --resume FILE`) into the one table (and figure), as the sweep run whole prints them.
     #[command(
         after_help = "Example:\n  pushbot eval merge fig11-1.jsonl fig11-2.jsonl fig11-3.jsonl --svg fig11.svg"
     )]

@@ -8,6 +8,7 @@
 //! - `fig11`: Lau et al. Fig. 11's table and figure from those trials.
 //! - `data_need`, `data_need_figure`: samples collected vs delivery success, for the paper's
 //!   collection and the active one (`eval delivery --figure 7`).
+//! - `jsonl`: the JSON-lines files that keep finished cells (header, then a cell a line).
 //! - `resume`: the file of finished cells that lets such an evaluation be interrupted and
 //!   resumed (`eval delivery --resume`).
 //! - [`shard`]: the K-th of N shares of a sweep's cells (`--shard K/N`), and the sweep each
@@ -19,6 +20,7 @@
 //!   planner on large rooms (`pushbot bench rearrange`).
 //! - `stable_trials`: stable pushing (Lynch & Mason §4) open and closed loop in perturbed
 //!   simulated worlds (`pushbot run stable`, `pushbot eval stable`).
+//! - `stable_sweep`: the file of finished stable trials (`eval stable --resume`, `--shard`).
 //! - `link_bench`: commands through a faulty wire to the in-process target (`pushbot bench
 //!   link`).
 
@@ -33,11 +35,15 @@ pub mod demo;
 #[cfg(feature = "sim")]
 pub mod fig11;
 #[cfg(feature = "sim")]
+pub mod jsonl;
+#[cfg(feature = "sim")]
 pub mod link_bench;
 pub mod rearrange_bench;
 #[cfg(feature = "sim")]
 pub mod resume;
 pub mod shard;
+#[cfg(feature = "sim")]
+pub mod stable_sweep;
 #[cfg(feature = "sim")]
 pub mod stable_trials;
 #[cfg(feature = "sim")]

@@ -14,13 +14,12 @@
 //! names it, and the file is left as it is.
 
 use std::collections::HashMap;
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 
+use super::jsonl::Appender;
 use super::shard::Sweep;
 use super::strategy_eval::{LabelledRun, Method, StartResult, TrialSetup};
 use crate::strategy::sample::Sample;
@@ -146,9 +145,8 @@ pub struct CellRecord {
 /// The file of a resumable run: the cells it holds, and appending new ones.
 #[derive(Debug)]
 pub struct Checkpoint {
-    path: PathBuf,
     done: HashMap<(String, String, Method), CellRecord>,
-    file: Mutex<std::fs::File>,
+    file: Appender,
 }
 
 /// A file's header and its whole cells, read without changing it.
@@ -167,44 +165,13 @@ impl FileCells {
     /// short (an interrupted run) is dropped; any other line that does not read is an error
     /// naming it.
     pub fn read(path: &Path) -> Result<Option<FileCells>> {
-        let shown = path.display();
-        let text = match std::fs::read(path) {
-            Ok(bytes) => String::from_utf8(bytes)
-                .map_err(|_| anyhow::anyhow!("{shown} is not a text file of pushbot's"))?,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => return Err(e).with_context(|| format!("reading {shown}")),
-        };
-        if text.is_empty() {
-            return Ok(None);
-        }
-        let lines: Vec<&str> = text.split_inclusive('\n').collect();
-        let header: RunKey = serde_json::from_str(lines[0].trim_end()).with_context(|| {
-            format!("{shown} line 1 is not the header of a `pushbot eval delivery --resume` file")
-        })?;
-        // A header without its newline was cut short before any cell: it is written again.
-        let mut keep = if lines[0].ends_with('\n') {
-            lines[0].len()
-        } else {
-            0
-        };
-        let mut cells = Vec::new();
-        for (i, line) in lines.iter().enumerate().skip(1) {
-            if i + 1 == lines.len() && !line.ends_with('\n') {
-                tracing::warn!(
-                    "{shown}: its last line was cut short (an interrupted run); that cell runs again"
-                );
-                break;
-            }
-            let c: CellRecord = serde_json::from_str(line.trim_end())
-                .with_context(|| format!("{shown} line {}", i + 1))?;
-            keep += line.len();
-            cells.push((i + 1, c));
-        }
-        Ok(Some(FileCells {
-            header,
-            cells,
-            keep,
-        }))
+        Ok(
+            super::jsonl::read(path, "pushbot eval delivery --resume")?.map(|l| FileCells {
+                header: l.header,
+                cells: l.records,
+                keep: l.keep,
+            }),
+        )
     }
 }
 
@@ -251,25 +218,9 @@ impl Checkpoint {
                 done.insert(k, c);
             }
         }
-        let mut file = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(path)
-            .with_context(|| format!("opening {shown} to write"))?;
-        file.set_len(keep as u64)
-            .with_context(|| format!("cutting {shown}'s partial last line"))?;
-        use std::io::Seek;
-        file.seek(std::io::SeekFrom::End(0))?;
-        if keep == 0 {
-            writeln!(file, "{}", serde_json::to_string(key)?)
-                .with_context(|| format!("writing {shown}"))?;
-            file.sync_data()?;
-        }
         Ok(Checkpoint {
-            path: path.to_owned(),
             done,
-            file: Mutex::new(file),
+            file: Appender::open(path, keep, key)?,
         })
     }
 
@@ -285,14 +236,7 @@ impl Checkpoint {
 
     /// Append a finished cell (one line, written through to the disk).
     pub fn record(&self, cell: &CellRecord) -> Result<()> {
-        let line = serde_json::to_string(cell)?;
-        let mut f = self
-            .file
-            .lock()
-            .map_err(|_| anyhow::anyhow!("{}: a writer panicked", self.path.display()))?;
-        writeln!(f, "{line}")
-            .and_then(|()| f.sync_data())
-            .with_context(|| format!("writing {}", self.path.display()))
+        self.file.append(cell)
     }
 }
 

@@ -277,7 +277,7 @@ pub fn robot_start_pose(p: &Problem, first: usize, seed: u64) -> Option<[f64; 3]
 }
 
 /// One trial's outcome.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct StableTrial {
     /// Trial number.
     pub trial: u64,
