@@ -101,7 +101,7 @@ const MAX_ITERS: usize = 300;
 const PROBE_ITERS: usize = 100;
 /// Bisection steps for a jammed robot's feasible fraction (2⁻¹⁰ of a step's motion).
 const BISECTIONS: usize = 10;
-const TOL: f64 = 1e-12;
+const TOL: f64 = 1e-10;
 /// A step is feasible when every linearised gap is closed to within this, m.
 pub const FEASIBLE: f64 = 1e-10;
 /// The solve keeps contacts this far apart (m), so that rounding never makes them overlap.
@@ -122,11 +122,6 @@ fn weight(m: &Mobile, j: [f64; 3]) -> f64 {
     m.s * (j[0] * j[0] + j[1] * j[1] + j[2] * j[2] / (m.c * m.c))
 }
 
-fn point_move(q: &[f64; 3], m: &Mobile, p: [f64; 2]) -> [f64; 2] {
-    let r = [p[0] - m.cof[0], p[1] - m.cof[1]];
-    [q[0] - q[2] * r[1], q[1] + q[2] * r[0]]
-}
-
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[0] + a[1] * b[1]
 }
@@ -145,22 +140,30 @@ fn solve_at(
         Some(w) => (w.normal.clone(), w.tangent.clone()),
         None => (vec![0.0; rows.len()], vec![0.0; rows.len()]),
     };
-    // Per-row constants: Jacobians and weights.
+    // Per-row constants: each moving side's body, Jacobians and compliances, and the weights.
+    // A side's relative motion along the normal (tangent) is the dot product of its Jacobian
+    // with the body's displacement: `jac(m, p, d) · q` is `d` dotted with the displacement of the
+    // body's point `p`.
+    #[derive(Clone, Copy)]
+    struct Side {
+        k: usize,
+        jn: [f64; 3],
+        jt: [f64; 3],
+        s: f64,
+        s_c2: f64,
+    }
     struct Pre {
-        jn: [Option<[f64; 3]>; 2],
-        jt: [Option<[f64; 3]>; 2],
+        sides: [Option<Side>; 2],
         wn: f64,
         wt: f64,
         kin_n: f64,
         kin_t: f64,
-        t: [f64; 2],
     }
     let pre: Vec<Pre> = rows
         .iter()
         .map(|r| {
             let t = [-r.n[1], r.n[0]];
-            let mut jn = [None, None];
-            let mut jt = [None, None];
+            let mut sides = [None, None];
             let (mut wn, mut wt, mut kin_n, mut kin_t) = (0.0, 0.0, 0.0, 0.0);
             for (side, (body, p, sign)) in [(r.a, r.pa, -1.0), (r.b, r.pb, 1.0)]
                 .into_iter()
@@ -169,12 +172,17 @@ fn solve_at(
                 match body {
                     BodyRef::Object(k) => {
                         let m = &mobiles[k];
-                        let a = jac(m, p, r.n);
-                        let b = jac(m, p, t);
-                        wn += weight(m, a);
-                        wt += weight(m, b);
-                        jn[side] = Some(a);
-                        jt[side] = Some(b);
+                        let jn = jac(m, p, r.n);
+                        let jt = jac(m, p, t);
+                        wn += weight(m, jn);
+                        wt += weight(m, jt);
+                        sides[side] = Some(Side {
+                            k,
+                            jn,
+                            jt,
+                            s: m.s,
+                            s_c2: m.s / (m.c * m.c),
+                        });
                     }
                     BodyRef::Robot => {
                         let u = drive.at(p, scale);
@@ -185,47 +193,49 @@ fn solve_at(
                 }
             }
             Pre {
-                jn,
-                jt,
+                sides,
                 wn,
                 wt,
                 kin_n,
                 kin_t,
-                t,
             }
         })
         .collect();
-    let apply = |moves: &mut [[f64; 3]], r: &Row, j: &[Option<[f64; 3]>; 2], dl: f64| {
-        for (side, body) in [r.a, r.b].into_iter().enumerate() {
-            if let (BodyRef::Object(k), Some(j)) = (body, j[side]) {
-                let m = &mobiles[k];
-                let f = if side == 0 { -dl } else { dl } * m.s;
-                moves[k][0] += f * j[0];
-                moves[k][1] += f * j[1];
-                moves[k][2] += f * j[2] / (m.c * m.c);
+    const SIGN: [f64; 2] = [-1.0, 1.0];
+    let apply = |moves: &mut [[f64; 3]], p: &Pre, normal: bool, dl: f64| {
+        for (side, sign) in p.sides.iter().zip(SIGN) {
+            if let Some(b) = side {
+                let j = if normal { b.jn } else { b.jt };
+                let f = sign * dl;
+                let q = &mut moves[b.k];
+                q[0] += f * b.s * j[0];
+                q[1] += f * b.s * j[1];
+                q[2] += f * b.s_c2 * j[2];
             }
         }
     };
-    let rel = |moves: &[[f64; 3]], r: &Row, dir: [f64; 2]| -> f64 {
+    let rel = |moves: &[[f64; 3]], p: &Pre, normal: bool| -> f64 {
         let mut g = 0.0;
-        for (body, p, sign) in [(r.a, r.pa, -1.0), (r.b, r.pb, 1.0)] {
-            if let BodyRef::Object(k) = body {
-                g += sign * dot(dir, point_move(&moves[k], &mobiles[k], p));
+        for (side, sign) in p.sides.iter().zip(SIGN) {
+            if let Some(b) = side {
+                let j = if normal { b.jn } else { b.jt };
+                let q = &moves[b.k];
+                g += sign * (j[0] * q[0] + j[1] * q[1] + j[2] * q[2]);
             }
         }
         g
     };
     if warm.is_some() {
-        for (i, r) in rows.iter().enumerate() {
-            apply(&mut moves, r, &pre[i].jn, ln[i]);
-            apply(&mut moves, r, &pre[i].jt, lt[i]);
+        for (i, p) in pre.iter().enumerate() {
+            apply(&mut moves, p, true, ln[i]);
+            apply(&mut moves, p, false, lt[i]);
         }
     }
     let violation = |moves: &[[f64; 3]]| {
         rows.iter()
             .zip(&pre)
             .filter(|(_, p)| p.wn > 0.0)
-            .map(|(r, p)| r.gap - target(r.gap) + p.kin_n + rel(moves, r, r.n))
+            .map(|(r, p)| r.gap - target(r.gap) + p.kin_n + rel(moves, p, true))
             .fold(0.0f64, |m, g| m.max(-g))
     };
     let mut last_violation = f64::INFINITY;
@@ -236,21 +246,21 @@ fn solve_at(
             if p.wn <= 0.0 {
                 continue;
             }
-            let g = r.gap - target(r.gap) + p.kin_n + rel(&moves, r, r.n);
+            let g = r.gap - target(r.gap) + p.kin_n + rel(&moves, p, true);
             let new = (ln[i] - g / p.wn).max(0.0);
             let dl = new - ln[i];
             if dl != 0.0 {
-                apply(&mut moves, r, &p.jn, dl);
+                apply(&mut moves, p, true, dl);
                 ln[i] = new;
                 change = change.max((dl * p.wn).abs());
             }
             if r.mu > 0.0 && p.wt > 0.0 {
-                let gt = p.kin_t + rel(&moves, r, p.t);
+                let gt = p.kin_t + rel(&moves, p, false);
                 let lim = r.mu * ln[i];
                 let new = (lt[i] - gt / p.wt).clamp(-lim, lim);
                 let dl = new - lt[i];
                 if dl != 0.0 {
-                    apply(&mut moves, r, &p.jt, dl);
+                    apply(&mut moves, p, false, dl);
                     lt[i] = new;
                     change = change.max((dl * p.wt).abs());
                 }
@@ -273,7 +283,7 @@ fn solve_at(
     // must not get worse than they started.
     let mut residual = 0.0f64;
     for (i, r) in rows.iter().enumerate() {
-        let g = r.gap + pre[i].kin_n + rel(&moves, r, r.n);
+        let g = r.gap + pre[i].kin_n + rel(&moves, &pre[i], true);
         let floor = if pre[i].wn > 0.0 {
             target(r.gap)
         } else {
@@ -312,7 +322,20 @@ pub fn solve(mobiles: &[Mobile], rows: &[Row], drive: &Drive, warm: Option<&Solu
     if first.residual <= FEASIBLE || hi == 0.0 {
         return first;
     }
-    // Jammed: bisect for the largest feasible fraction (each probe warm-started from the
+    // Jammed. A robot held against the same contacts as in the last step (`warm`, whose
+    // rows are these) can mostly go as far as it could then: when that fraction is feasible
+    // and one bisection step more is not, it is the answer bisection would narrow to.
+    let step = hi / f64::from(1u32 << BISECTIONS);
+    if let Some(w) = warm.filter(|w| w.scale < hi) {
+        let at = solve_at(mobiles, rows, drive, w.scale, Some(w), PROBE_ITERS);
+        if at.residual <= FEASIBLE {
+            let above = solve_at(mobiles, rows, drive, w.scale + step, Some(&at), PROBE_ITERS);
+            if above.residual > FEASIBLE {
+                return at;
+            }
+        }
+    }
+    // Otherwise bisect for the largest feasible fraction (each probe warm-started from the
     // last feasible one). Standing still is feasible when nothing overlaps to begin with.
     let mut lo = 0.0;
     let mut best = solve_at(mobiles, rows, drive, 0.0, None, MAX_ITERS);

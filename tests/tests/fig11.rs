@@ -84,3 +84,55 @@ fn figure_11_refuses_a_scene_and_other_figures() {
         assert!(err.contains("--figure"), "{args:?}: {err}");
     }
 }
+
+/// `pushbot bench eval --json`: the same cells with the truth camera and the rendered one, each
+/// with its trials per second and the simulation's real-time factor, consistent with the wall
+/// and simulated times it reports.
+#[test]
+fn bench_eval_times_the_trials_with_each_camera() {
+    let strategies = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../results/fig11-rendered/strategies");
+    let out = Command::new(pushbot_tests::bin("pushbot"))
+        .args([
+            "--json",
+            "bench",
+            "eval",
+            "--scene",
+            "lau-irregular",
+            "--start",
+            "A",
+            "--method",
+            "learned",
+            "--time-limit",
+            "20",
+            "--strategy-dir",
+        ])
+        .arg(&strategies)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(v["scene"], "lau-irregular");
+    for camera in ["truth", "rendered"] {
+        let c = &v[camera];
+        assert_eq!(c["camera"], camera);
+        assert_eq!(c["trials"].as_u64(), Some(1), "{c}");
+        let (wall, sim) = (c["wall_s"].as_f64().unwrap(), c["sim_s"].as_f64().unwrap());
+        assert!(wall > 0.0 && sim > 0.0 && sim <= 21.0, "{c}");
+        let rate = c["trials_per_s"].as_f64().unwrap();
+        assert!((rate - 1.0 / wall).abs() < 1e-9 * rate.max(1.0), "{c}");
+        let factor = c["realtime_factor"].as_f64().unwrap();
+        assert!((factor - sim / wall).abs() < 1e-9 * factor.max(1.0), "{c}");
+    }
+    // The rendered camera draws and reads a frame at every look: its simulated seconds cost
+    // more wall time.
+    assert!(
+        v["rendered"]["realtime_factor"].as_f64() < v["truth"]["realtime_factor"].as_f64(),
+        "{v}"
+    );
+}

@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
+pub mod bench_eval;
 pub mod console;
 #[cfg(feature = "sim")]
 mod data_need;
@@ -182,6 +183,9 @@ pub enum BenchCommand {
     /// Commands through a faulty wire to the built-in simulated target: what completed, what
     /// the robot executed twice, watchdog trips, retries, latency.
     Link(link_bench::BenchLinkArgs),
+    /// The delivery evaluation (Lau et al. Fig. 11) with the truth camera and with the rendered
+    /// one: trials per second of wall time and the simulation's real-time factor.
+    Eval(bench_eval::BenchEvalArgs),
     #[command(flatten)]
     Vision(vision::BenchCommand),
     #[command(flatten)]
@@ -446,6 +450,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Bench(BenchCommand::Rearrange(args)) => rearrange::bench(&global, args),
         Command::Bench(BenchCommand::Stable(a)) => stable::run_bench(&global, &a),
         Command::Bench(BenchCommand::Link(a)) => link_bench::run(&global, &a),
+        Command::Bench(BenchCommand::Eval(a)) => bench_eval::run(&global, &a),
         Command::Calibrate(a) => lens::run(&global, a),
         Command::Track(a) => vision::track(&global, a),
         Command::Replay(a) => replay::run(&global, a),

@@ -5,6 +5,8 @@
 //! - [`trials`]: statistics of delivery trials (Lau et al. §V, Fig. 11), for any robot.
 //! - `strategy_eval`: delivery trials of the learned strategy and the dipole field from the
 //!   scene's start positions (Lau et al. §V, Fig. 11), simulated.
+//! - `eval_bench`: those trials' speed with the truth and the rendered camera (`pushbot bench
+//!   eval`).
 //! - `fig11`: Lau et al. Fig. 11's table and figure from those trials.
 //! - `data_need`, `data_need_figure`: samples collected vs delivery success, for the paper's
 //!   collection and the active one (`eval delivery --figure 7`).
@@ -32,6 +34,8 @@ pub mod data_need_figure;
 pub mod delivery;
 #[cfg(feature = "sim")]
 pub mod demo;
+#[cfg(feature = "sim")]
+pub mod eval_bench;
 #[cfg(feature = "sim")]
 pub mod fig11;
 #[cfg(feature = "sim")]
