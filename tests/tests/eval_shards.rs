@@ -26,7 +26,7 @@ fn sweep(extra: &[&str]) -> Command {
         "--start",
         "A,B",
         "--time-limit",
-        "15",
+        "8",
         "--sim-camera",
         "truth",
         "--strategy-dir",
