@@ -35,7 +35,7 @@ pub struct CameraRate {
     pub threads: usize,
 }
 
-/// What [`bench`] measured.
+/// What [`bench()`] measured.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct EvalBench {
     /// The scene's name.
