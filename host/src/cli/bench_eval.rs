@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::strategy_args::MethodArg;
+use super::strategy_args::{MethodArg, scene_with_starts};
 use super::{CliError, CliResult, Global};
 use crate::experiments::trials::parse_starts;
 
@@ -65,18 +65,9 @@ pub fn run(g: &Global, a: &BenchEvalArgs) -> CliResult {
     use crate::experiments::strategy_eval::{Method, TrialSetup};
     use crate::sim::robot::SimRobotOptions;
     use crate::strategy::regression::KernelParams;
-    use pushbot_world::Scene;
 
     let starts = a.check()?;
-    let scene = Scene::preset_or_file(&a.scene).map_err(|e| CliError::bad_input(e.to_string()))?;
-    for s in &starts {
-        if scene.position(s).is_none() {
-            return Err(CliError::bad_input(format!(
-                "scene {} has no start position {s}",
-                scene.name
-            )));
-        }
-    }
+    let scene = scene_with_starts(&a.scene, &starts)?;
     let setup = TrialSetup {
         scene,
         object: None,
@@ -91,11 +82,7 @@ pub fn run(g: &Global, a: &BenchEvalArgs) -> CliResult {
         kernel: KernelParams::default(),
     };
     setup.goal().map_err(CliError::BadInput)?;
-    let methods: Vec<Method> = match a.method {
-        MethodArg::Learned => vec![Method::Learned],
-        MethodArg::Dipole => vec![Method::Dipole],
-        MethodArg::Both => vec![Method::Dipole, Method::Learned],
-    };
+    let methods = a.method.methods();
     let samples = if !methods.contains(&Method::Learned) {
         Vec::new()
     } else if let Some(path) = &a.strategy {

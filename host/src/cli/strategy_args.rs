@@ -224,6 +224,31 @@ pub enum MethodArg {
     Both,
 }
 
+impl MethodArg {
+    /// The methods it names, the baseline first.
+    pub fn methods(self) -> Vec<crate::experiments::strategy_eval::Method> {
+        use crate::experiments::strategy_eval::Method;
+        match self {
+            MethodArg::Learned => vec![Method::Learned],
+            MethodArg::Dipole => vec![Method::Dipole],
+            MethodArg::Both => vec![Method::Dipole, Method::Learned],
+        }
+    }
+}
+
+/// Scene `name` (a preset or a file), refused unless it has every start position of `starts`.
+pub fn scene_with_starts(name: &str, starts: &[String]) -> Result<pushbot_world::Scene, CliError> {
+    let scene = pushbot_world::Scene::preset_or_file(name)
+        .map_err(|e| CliError::bad_input(e.to_string()))?;
+    if let Some(s) = starts.iter().find(|s| scene.position(s).is_none()) {
+        return Err(CliError::bad_input(format!(
+            "scene {} has no start position {s}",
+            scene.name
+        )));
+    }
+    Ok(scene)
+}
+
 /// `pushbot eval delivery`.
 #[derive(Args, Debug)]
 pub struct DeliveryArgs {

@@ -9,7 +9,7 @@ use serde_json::json;
 
 use super::SimCameraArg;
 use super::progress_bar;
-use super::strategy_args::{CollectArgs, DeliveryArgs, MethodArg, SimArgs};
+use super::strategy_args::{CollectArgs, DeliveryArgs, SimArgs, scene_with_starts};
 use super::{CliError, CliResult, Global, Status};
 use crate::exec::collect::{CollectParams, CollectReport, collect};
 use crate::exec::deliver::Delivery;
@@ -282,15 +282,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
     }
     let mut setups = Vec::new();
     for n in &names {
-        let scene = Scene::preset_or_file(n).map_err(|e| CliError::bad_input(e.to_string()))?;
-        for s in &starts {
-            if scene.position(s).is_none() {
-                return Err(CliError::bad_input(format!(
-                    "scene {} has no start position {s}",
-                    scene.name
-                )));
-            }
-        }
+        let scene = scene_with_starts(n, &starts)?;
         let setup = TrialSetup {
             scene,
             object: a.object.clone(),
@@ -304,11 +296,7 @@ pub(super) fn eval_in_sim(global: &Global, mut a: DeliveryArgs) -> CliResult {
     if a.svg.is_some() && a.figure.is_none() && setups.len() != 1 {
         return Err(CliError::bad_input("--svg draws one scene's trajectories"));
     }
-    let methods: Vec<Method> = match a.method {
-        MethodArg::Learned => vec![Method::Learned],
-        MethodArg::Dipole => vec![Method::Dipole],
-        MethodArg::Both => vec![Method::Dipole, Method::Learned],
-    };
+    let methods = a.method.methods();
     // The strategies, every scene's on its own core.
     let several = setups.len() > 1;
     let strategies = names

@@ -13,12 +13,14 @@ use pushbot_world::Scene;
 
 use super::inprocess::SimRef;
 use super::target::SceneCamera;
-use crate::vision::Pipeline;
 use crate::vision::calibration::Calibration;
 use crate::vision::detect::{DetectorKind, make_detector};
+use crate::vision::layout::wrap_angle;
 use crate::vision::layout::{MarkerLayout, Pose};
 use crate::vision::source::Frame;
 use crate::vision::tracking::TrackerParams;
+use crate::vision::{MotionBound, Pipeline};
+use pushbot_sim::camera::render::Window;
 
 /// Frames the calibration is fitted through (as [`crate::exec::LiveRobot`] does).
 const CALIBRATION_FRAMES: usize = 3;
@@ -37,7 +39,17 @@ pub struct RenderedCamera {
     /// Latest tracked pose of each body (the world's coordinates) and its frame time.
     poses: HashMap<String, (Pose, f64)>,
     frames: u64,
+    /// The frames' size, pixels.
+    size: (u32, u32),
+    /// The robot's odometry (its own frame) at the last look, and the look's time.
+    odometry: Option<(f64, pushbot_protocol::Pose)>,
+    /// The farthest a point of the robot or of an object it pushes is from the robot's
+    /// centre, metres.
+    reach: f64,
 }
+
+/// Odometry's error and the tracker's margin in a motion bound, metres.
+const BOUND_SLACK_M: f64 = 0.01;
 
 impl std::fmt::Debug for RenderedCamera {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -62,7 +74,7 @@ impl RenderedCamera {
         let mut size = [0, 0];
         let mut seq = 0;
         for k in 0..CALIBRATION_FRAMES {
-            let frame = render(&mut camera, sim, seq, k as f64 * period)?;
+            let frame = render(&mut camera, sim, seq, k as f64 * period, None)?;
             seq += 1;
             size = [frame.width, frame.height];
             seen.push(det.detect_fine(&frame)?);
@@ -89,6 +101,16 @@ impl RenderedCamera {
             seq,
             poses: HashMap::new(),
             frames: 0,
+            size: (size[0], size[1]),
+            odometry: None,
+            reach: scene.robot.bumper_radius
+                + 2.0
+                    * scene
+                        .objects
+                        .iter()
+                        .flat_map(|o| o.outline.iter())
+                        .map(|p| p[0].hypot(p[1]))
+                        .fold(0.0, f64::max),
         })
     }
 
@@ -104,11 +126,48 @@ impl RenderedCamera {
 
     /// Render the world as `sim` holds it and read the frame; true when `want` (every body
     /// when empty) was seen in it.
+    ///
+    /// Between whole-frame searches the sensor is read out only in the regions the tracker
+    /// will search ([`Pipeline::plan`]); when they miss a body, the same image is read out
+    /// whole (fresh noise) and searched whole, as the pipeline does a camera's full frame.
     pub fn look(&mut self, sim: &SimRef<'_>, want: &[&str]) -> Result<bool> {
         let time = sim.now_us() as f64 * 1e-6;
-        let frame = render(&mut self.camera, sim, self.seq, time)?;
+        let (width, height) = self.size;
+        // Nothing but the robot moves things here: what moved since the last look moved no
+        // farther than the robot's odometry says it went (twice, for a pushed object that
+        // turns about its contact), each point of it at most its reach from its centre.
+        let odometry = sim.truth().odometry;
+        if let Some((since, before)) = self.odometry.replace((time, odometry)) {
+            let moved = f64::from(odometry.x - before.x).hypot(f64::from(odometry.y - before.y));
+            let turned = wrap_angle(f64::from(odometry.theta - before.theta)).abs();
+            let metres = 2.0 * (moved + turned * self.reach) + BOUND_SLACK_M;
+            self.pipeline.bound_motion(MotionBound { since, metres });
+        }
+        let planned = self.pipeline.plan(time, width, height);
+        let within = planned.as_ref().map(|rs| {
+            rs.iter()
+                .map(|r| Window {
+                    x0: r.x as usize,
+                    y0: r.y as usize,
+                    x1: (r.x + r.width) as usize,
+                    y1: (r.y + r.height) as usize,
+                })
+                .collect::<Vec<_>>()
+        });
+        let frame = render(&mut self.camera, sim, self.seq, time, within.as_deref())?;
         self.seq += 1;
-        let r = self.pipeline.process(&frame)?;
+        let partial = match &planned {
+            Some(regions) => self.pipeline.process_regions(&frame, regions)?,
+            None => Some(self.pipeline.process_whole(&frame)?),
+        };
+        let r = match partial {
+            Some(r) => r,
+            None => {
+                let frame = render(&mut self.camera, sim, self.seq, time, None)?;
+                self.seq += 1;
+                self.pipeline.process_whole(&frame)?
+            }
+        };
         self.frames += 1;
         let mut seen = Vec::new();
         for t in r.tracked.iter().filter(|t| t.seen && !t.rejected) {
@@ -124,13 +183,22 @@ impl RenderedCamera {
     }
 }
 
-/// One frame of the world as `sim` holds it, stamped `time`.
-fn render(camera: &mut SceneCamera, sim: &SimRef<'_>, seq: u64, time: f64) -> Result<Frame> {
+/// One frame of the world as `sim` holds it, stamped `time`; read out only `within` these
+/// windows when given.
+fn render(
+    camera: &mut SceneCamera,
+    sim: &SimRef<'_>,
+    seq: u64,
+    time: f64,
+    within: Option<&[Window]>,
+) -> Result<Frame> {
     let robot = sim.truth().pose;
     let objects = sim.object_poses();
-    let f = camera
-        .capture(time, &robot, &objects)
-        .map_err(|e| anyhow!("rendering a camera frame: {e}"))?;
+    let f = match within {
+        Some(w) => camera.capture_within(time, &robot, &objects, w),
+        None => camera.capture(time, &robot, &objects),
+    }
+    .map_err(|e| anyhow!("rendering a camera frame: {e}"))?;
     Ok(Frame {
         seq,
         time: f.time,

@@ -54,8 +54,8 @@ use calibration::Calibration;
 use detection::{DetectError, Detection, Detector};
 use frame::Frame;
 use layout::{MarkerLayout, Pose};
-pub use roi::RoiParams;
 use roi::Sighting;
+pub use roi::{MotionBound, RoiParams};
 use tracking::{TrackedPose, Tracker, TrackerParams};
 
 /// One body's pose measured from one detection (before filtering).
@@ -125,6 +125,9 @@ pub struct FrameResult {
     pub off_table: usize,
 }
 
+/// What one search found: its detections and the body poses measured from them.
+type Seen = (Vec<Detection>, Vec<Measurement>);
+
 /// How far past the table's edge a body's centre may be measured, metres.
 pub const OFF_TABLE_MARGIN: f64 = 0.05;
 
@@ -142,12 +145,23 @@ pub struct Pipeline {
     last_seen: Vec<(String, Sighting)>,
     /// The camera's lens: detections are undistorted before they are measured.
     lens: Option<pushbot_world::lens::Intrinsics>,
-    /// Time of the last whole-frame search at full resolution.
-    last_fine: Option<f64>,
+    /// Of each body that whole-frame searches at full resolution have not found: when the
+    /// last one was, and the seconds to wait before the next.
+    fine_backoff: Vec<(String, f64, f64)>,
+    /// How far anything can have moved since some time, when the caller knows it.
+    bound: Option<MotionBound>,
 }
 
-/// Seconds between whole-frame searches at full resolution while a body is not found.
+/// Seconds between whole-frame searches at full resolution while a body is not found; the
+/// wait doubles with every search that does not find it, up to [`FINE_EVERY_MAX`].
 const FINE_EVERY: f64 = 0.5;
+
+/// Seconds after its last sighting during which a missing body has every frame searched whole.
+const REACQUIRE_S: f64 = 5.0;
+
+/// The longest wait between whole-frame searches at full resolution for a body still not
+/// found (a goal's marker under the object): such a search is the slowest a frame can take.
+const FINE_EVERY_MAX: f64 = 8.0;
 
 impl std::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -179,7 +193,8 @@ impl Pipeline {
             sightings: Vec::new(),
             last_seen: Vec::new(),
             lens,
-            last_fine: None,
+            fine_backoff: Vec::new(),
+            bound: None,
         }
     }
 
@@ -193,6 +208,14 @@ impl Pipeline {
             ),
             None => measure(dets, &self.calibration, &self.layout),
         }
+    }
+
+    /// Nothing on the table has moved farther than `bound` says since its time (the caller's
+    /// knowledge: its robot's odometry, when nothing else moves things): the regions around
+    /// markers seen since then reach no farther, however long the gap. A marker that moved
+    /// farther anyway is missed in its region and found by the whole-frame search after it.
+    pub fn bound_motion(&mut self, bound: MotionBound) {
+        self.bound = Some(bound);
     }
 
     /// The same pipeline with other region-of-interest settings.
@@ -223,65 +246,103 @@ impl Pipeline {
         &self.layout
     }
 
-    /// The regions around each body's predicted marker, or `None` when the whole frame is due.
-    fn regions(&self, frame: &Frame) -> Option<Vec<detection::Region>> {
+    /// The regions the next frame (taken at `time`, `width × height` pixels) will be searched
+    /// in — around each body's predicted marker — or `None` when the whole frame is due. A
+    /// camera that can read out parts of its sensor needs only these
+    /// ([`Self::process_regions`]).
+    pub fn plan(&self, time: f64, width: u32, height: u32) -> Option<Vec<detection::Region>> {
         if self.roi.full_every <= 1
             || self.since_full + 1 >= self.roi.full_every
             || self.sightings.is_empty()
         {
             return None;
         }
-        self.sightings
+        self.expected(time)
             .iter()
-            .map(|(_, s)| s.region(frame.time, frame.width, frame.height, &self.roi))
+            .map(|(_, s, lost)| {
+                // A lost body may have moved farther than the bound (it was not seen when the
+                // bound began): its region reaches as far as bodies move.
+                let bound = if *lost { None } else { self.bound };
+                s.region(time, width, height, &self.roi, bound)
+            })
             .collect()
     }
 
-    /// Detect and measure: in the regions of interest when they are due and find every body
-    /// expected, in the whole frame otherwise.
-    fn look(
-        &mut self,
-        frame: &Frame,
-    ) -> Result<(Vec<Detection>, Vec<Measurement>, bool), DetectError> {
-        if let Some(regions) = self.regions(frame) {
-            let mut dets: Vec<Detection> = Vec::new();
-            let names: Vec<String> = self.sightings.iter().map(|(b, _)| b.clone()).collect();
-            for (r, body) in regions.into_iter().zip(&names) {
-                let mut found = self.detector.detect_region(frame, r)?;
-                // A marker too small for the decimated search: look again at full resolution.
-                let want = self.layout.bodies.iter().find(|b| &b.body == body);
-                if let Some(b) = want
-                    && !found.iter().any(|d| d.family == b.family && d.id == b.id)
-                {
-                    found = self.detector.detect_region_fine(frame, r)?;
-                }
-                for d in found {
-                    // Overlapping regions find the same marker twice: keep one.
-                    let dup = dets.iter().any(|e| {
-                        e.family == d.family
-                            && e.id == d.id
-                            && (e.centre[0] - d.centre[0]).hypot(e.centre[1] - d.centre[1]) < 2.0
-                    });
-                    if !dup {
-                        dets.push(d);
-                    }
-                }
-            }
-            let ms = self.measure_raw(&dets);
-            if self
-                .sightings
-                .iter()
-                .all(|(b, _)| ms.iter().any(|m| &m.body == b))
+    /// The bodies a frame at `time` is searched for in regions: those in the last frame, then
+    /// those seen lately but not in it (true), until they are found again or have been missing
+    /// for REACQUIRE_S (then they are hidden, and the scheduled whole-frame searches look for
+    /// them).
+    fn expected(&self, time: f64) -> Vec<(String, Sighting, bool)> {
+        let mut out: Vec<(String, Sighting, bool)> = self
+            .sightings
+            .iter()
+            .map(|(b, s)| (b.clone(), *s, false))
+            .collect();
+        for (body, s) in &self.last_seen {
+            if !self.sightings.iter().any(|(b, _)| b == body)
+                && (0.0..REACQUIRE_S).contains(&(time - s.time()))
             {
-                self.since_full += 1;
-                return Ok((dets, ms, false));
+                out.push((body.clone(), *s, true));
             }
         }
+        out
+    }
+
+    /// Detect and measure in `regions` (as [`Self::plan`] gave them, one per body seen in the
+    /// last frame); `None` when they do not find every body expected.
+    fn look_regions(
+        &mut self,
+        frame: &Frame,
+        regions: &[detection::Region],
+    ) -> Result<Option<Seen>, DetectError> {
+        let expected = self.expected(frame.time);
+        if regions.len() != expected.len() || regions.is_empty() {
+            return Ok(None);
+        }
+        let mut dets: Vec<Detection> = Vec::new();
+        for (&r, (body, _, lost)) in regions.iter().zip(&expected) {
+            let mut found = self.detector.detect_region(frame, r)?;
+            // A marker too small for the decimated search: look again at full resolution (not
+            // for a lost one in its wide region: the whole-frame searches do that).
+            let want = self.layout.bodies.iter().find(|b| &b.body == body);
+            if let Some(b) = want
+                && !lost
+                && !found.iter().any(|d| d.family == b.family && d.id == b.id)
+            {
+                found = self.detector.detect_region_fine(frame, r)?;
+            }
+            for d in found {
+                // Overlapping regions find the same marker twice: keep one.
+                let dup = dets.iter().any(|e| {
+                    e.family == d.family
+                        && e.id == d.id
+                        && (e.centre[0] - d.centre[0]).hypot(e.centre[1] - d.centre[1]) < 2.0
+                });
+                if !dup {
+                    dets.push(d);
+                }
+            }
+        }
+        let ms = self.measure_raw(&dets);
+        if self
+            .sightings
+            .iter()
+            .all(|(b, _)| ms.iter().any(|m| &m.body == b))
+        {
+            self.since_full += 1;
+            return Ok(Some((dets, ms)));
+        }
+        Ok(None)
+    }
+
+    /// Detect and measure in the whole frame (and at full resolution where a body is missing).
+    fn look_whole(&mut self, frame: &Frame) -> Result<Seen, DetectError> {
         let mut dets = self.detector.detect(frame)?;
         let mut ms = self.measure_raw(&dets);
         // A body of the layout not found: search at full resolution too (its marker may be
         // small or far). Where it was last seen recently enough, only there; otherwise the
-        // whole frame, at most every FINE_EVERY seconds.
+        // whole frame, every FINE_EVERY seconds at first and less often while it is not found
+        // there (hidden: the object over its goal's marker).
         let missing: Vec<&str> = self
             .layout
             .bodies
@@ -289,30 +350,56 @@ impl Pipeline {
             .filter(|b| !ms.iter().any(|m| m.body == b.body))
             .map(|b| b.body.as_str())
             .collect();
-        let regions: Option<Vec<detection::Region>> = missing
-            .iter()
-            .map(|body| {
-                let (_, s) = self.last_seen.iter().find(|(b, _)| b == body)?;
-                s.region(frame.time, frame.width, frame.height, &self.roi)
-            })
-            .collect();
-        let fine = match regions {
-            _ if missing.is_empty() => Vec::new(),
-            Some(regions) if self.roi.full_every > 1 => {
-                let mut fine = Vec::new();
-                for r in regions {
-                    fine.extend(self.detector.detect_region_fine(frame, r)?);
+        let mut regions = Vec::new();
+        let mut whole = Vec::new();
+        for body in &missing {
+            let region = self
+                .last_seen
+                .iter()
+                .find(|(b, _)| b == body)
+                .and_then(|(_, s)| {
+                    s.fine_region(frame.time, frame.width, frame.height, &self.roi, self.bound)
+                });
+            match region {
+                Some(r) if self.roi.full_every > 1 => regions.push(r),
+                _ => whole.push(*body),
+            }
+        }
+        let due = whole.iter().any(|body| {
+            self.fine_backoff
+                .iter()
+                .find(|(b, _, _)| b == body)
+                .is_none_or(|&(_, last, wait)| !(0.0..wait).contains(&(frame.time - last)))
+        });
+        let fine = if due {
+            let fine = self.detector.detect_fine(frame)?;
+            let found = self.measure_raw(&fine);
+            for body in whole {
+                let entry = self.fine_backoff.iter().position(|(b, _, _)| b == body);
+                match entry {
+                    _ if found.iter().any(|m| m.body == body) => {
+                        if let Some(i) = entry {
+                            self.fine_backoff.remove(i);
+                        }
+                    }
+                    Some(i) => {
+                        let (_, last, wait) = &mut self.fine_backoff[i];
+                        *last = frame.time;
+                        *wait = (*wait * 2.0).min(FINE_EVERY_MAX);
+                    }
+                    None => {
+                        self.fine_backoff
+                            .push((body.to_string(), frame.time, FINE_EVERY));
+                    }
                 }
-                fine
             }
-            _ if self
-                .last_fine
-                .is_none_or(|t| !(0.0..FINE_EVERY).contains(&(frame.time - t))) =>
-            {
-                self.last_fine = Some(frame.time);
-                self.detector.detect_fine(frame)?
+            fine
+        } else {
+            let mut fine = Vec::new();
+            for r in regions {
+                fine.extend(self.detector.detect_region_fine(frame, r)?);
             }
-            _ => Vec::new(),
+            fine
         };
         if !fine.is_empty() {
             for d in fine {
@@ -323,7 +410,7 @@ impl Pipeline {
             ms = self.measure_raw(&dets);
         }
         self.since_full = 0;
-        Ok((dets, ms, true))
+        Ok((dets, ms))
     }
 
     /// Remember where each measured body's marker was seen.
@@ -354,8 +441,41 @@ impl Pipeline {
         self.sightings = next;
     }
 
-    /// Process one frame.
+    /// Process one frame: searched in the regions of interest when they are due and find
+    /// every body expected, in the whole frame otherwise.
     pub fn process(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
+        self.check_size(frame)?;
+        if let Some(regions) = self.plan(frame.time, frame.width, frame.height)
+            && let Some(r) = self.process_regions(frame, &regions)?
+        {
+            return Ok(r);
+        }
+        self.process_whole(frame)
+    }
+
+    /// Process a frame of which only `regions` (as [`Self::plan`] gave them for it) are read:
+    /// `None`, and nothing learnt, when they do not find every body expected — then the whole
+    /// frame is needed ([`Self::process_whole`]).
+    pub fn process_regions(
+        &mut self,
+        frame: &Frame,
+        regions: &[detection::Region],
+    ) -> Result<Option<FrameResult>, DetectError> {
+        self.check_size(frame)?;
+        Ok(self
+            .look_regions(frame, regions)?
+            .map(|(dets, ms)| self.learn(frame, dets, ms, false)))
+    }
+
+    /// Process a frame searched whole, whatever regions are due.
+    pub fn process_whole(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
+        self.check_size(frame)?;
+        let (dets, ms) = self.look_whole(frame)?;
+        Ok(self.learn(frame, dets, ms, true))
+    }
+
+    /// A frame of another size than the calibration's is refused.
+    fn check_size(&self, frame: &Frame) -> Result<(), DetectError> {
         if [frame.width, frame.height] != self.calibration.image_size {
             let [w, h] = self.calibration.image_size;
             return Err(DetectError::Failed(format!(
@@ -364,7 +484,17 @@ impl Pipeline {
                 frame.width, frame.height
             )));
         }
-        let (detections, mut measurements, full_frame) = self.look(frame)?;
+        Ok(())
+    }
+
+    /// Drop what is off the table, remember where the markers were, update the tracker.
+    fn learn(
+        &mut self,
+        frame: &Frame,
+        detections: Vec<Detection>,
+        mut measurements: Vec<Measurement>,
+        full_frame: bool,
+    ) -> FrameResult {
         let [w, d] = self.layout.table;
         let m = OFF_TABLE_MARGIN;
         let before = measurements.len();
@@ -379,7 +509,7 @@ impl Pipeline {
             .map(|m| (m.body.clone(), m.body_pose))
             .collect();
         let tracked = self.tracker.update(frame.time, &obs);
-        Ok(FrameResult {
+        FrameResult {
             seq: frame.seq,
             time: frame.time,
             detections,
@@ -387,7 +517,7 @@ impl Pipeline {
             tracked,
             full_frame,
             off_table,
-        })
+        }
     }
 }
 

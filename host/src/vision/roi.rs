@@ -50,6 +50,17 @@ impl RoiParams {
     }
 }
 
+/// What the caller knows of how far things moved: nothing on the table has moved more than
+/// `metres` since `since` (the frames' clock) — from its robot's odometry, when nothing but the
+/// robot moves things. A region after a gap then reaches no farther than that.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionBound {
+    /// Since when, seconds.
+    pub since: f64,
+    /// The farthest anything moved, metres.
+    pub metres: f64,
+}
+
 /// Where a body's marker was last seen in the image.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Sighting {
@@ -103,6 +114,11 @@ impl Sighting {
         })
     }
 
+    /// When it was seen, seconds.
+    pub(super) fn time(&self) -> f64 {
+        self.time
+    }
+
     /// The square to search for this marker in a `width × height` frame taken at `time`, or
     /// `None` when it would be wider than half the frame's shorter side (or the frame is
     /// older than the sighting).
@@ -112,6 +128,35 @@ impl Sighting {
         width: u32,
         height: u32,
         roi: &RoiParams,
+        bound: Option<MotionBound>,
+    ) -> Option<Region> {
+        let widest = f64::from(width.min(height)) / 2.0;
+        self.region_within(time, width, height, roi, bound, widest)
+    }
+
+    /// The square to search at full resolution for this marker, missing from a whole-frame
+    /// search: as [`Self::region`], as wide as the frame's longer side (clipped to the frame),
+    /// so that even after a gap it costs a fraction of the whole frame at full resolution.
+    pub(super) fn fine_region(
+        &self,
+        time: f64,
+        width: u32,
+        height: u32,
+        roi: &RoiParams,
+        bound: Option<MotionBound>,
+    ) -> Option<Region> {
+        let widest = f64::from(width.max(height));
+        self.region_within(time, width, height, roi, bound, widest)
+    }
+
+    fn region_within(
+        &self,
+        time: f64,
+        width: u32,
+        height: u32,
+        roi: &RoiParams,
+        bound: Option<MotionBound>,
+        widest: f64,
     ) -> Option<Region> {
         let dt = time - self.time;
         if !(0.0..).contains(&dt) {
@@ -124,11 +169,16 @@ impl Sighting {
             ];
             (c, 0.0)
         } else {
-            (self.centre, roi.max_speed * dt * self.px_per_m)
+            let mut reach = roi.max_speed * dt;
+            if let Some(b) = bound
+                && b.since <= self.time
+            {
+                reach = reach.min(b.metres);
+            }
+            (self.centre, reach * self.px_per_m)
         };
         // The marker's bounding square at any heading, plus the margin and reach on each side.
         let side = self.side_px * std::f64::consts::SQRT_2 + 2.0 * (roi.margin_px + reach);
-        let widest = f64::from(width.min(height)) / 2.0;
         if side.is_nan() || side > widest {
             return None;
         }
@@ -170,18 +220,39 @@ mod tests {
         assert_eq!(s.velocity, [100.0, 0.0]);
         assert!((s.px_per_m - 800.0).abs() < 1e-9);
         // 0.1 s on: 10 px further, the square 40√2 + 40 = 96.6 → 112 px.
-        let r = s.region(0.2, 960, 720, &roi).unwrap();
+        let r = s.region(0.2, 960, 720, &roi, None).unwrap();
         assert_eq!((r.width, r.height), (112, 112));
         assert!((f64::from(r.x) + 56.0 - 320.0).abs() <= 1.0, "{r:?}");
         // 0.3 s after the sighting: centred where it was seen, reaching 0.5 m/s × 0.3 s ×
         // 800 px/m = 120 px further on each side: 336.6 → 352 px.
-        let r = s.region(0.4, 960, 720, &roi).unwrap();
+        let r = s.region(0.4, 960, 720, &roi, None).unwrap();
         assert_eq!((r.width, r.height), (352, 352));
         assert!((f64::from(r.x) + 176.0 - 310.0).abs() <= 1.0, "{r:?}");
         // 0.4 s: 416.6 px, wider than half of 720: not a region.
-        assert!(s.region(0.5, 960, 720, &roi).is_none());
+        assert!(s.region(0.5, 960, 720, &roi, None).is_none());
+        // At full resolution after a whole-frame miss, up to the frame's longer side, clipped:
+        // 0.5 s after the sighting, 40√2 + 40 + 2 · 160 = 416.6 → 432 px.
+        let r = s.fine_region(0.5, 960, 720, &roi, None).unwrap();
+        assert_eq!((r.width, r.height), (432, 432));
+        // 0.9 s: 736.6 px → 752 px wide, clipped to the frame's 720 rows.
+        let r = s.fine_region(0.9, 960, 720, &roi, None).unwrap();
+        assert_eq!((r.width, r.height), (752, 720));
+        assert!(s.fine_region(1.2, 960, 720, &roi, None).is_none());
+        // Known to have moved at most 5 cm since the sighting: 40√2 + 40 + 2 · 40 = 176.6 →
+        // 192 px, even 0.4 s on (a bound from before the sighting covers the gap too); one from
+        // after the sighting says nothing of it.
+        let b = MotionBound {
+            since: 0.1,
+            metres: 0.05,
+        };
+        let r = s.region(0.5, 960, 720, &roi, Some(b)).unwrap();
+        assert_eq!((r.width, r.height), (192, 192));
+        let early = MotionBound { since: 0.0, ..b };
+        assert_eq!(s.region(0.5, 960, 720, &roi, Some(early)), Some(r));
+        let late = MotionBound { since: 0.2, ..b };
+        assert!(s.region(0.5, 960, 720, &roi, Some(late)).is_none());
         // A frame older than the sighting is not predicted backwards.
-        assert!(s.region(0.05, 960, 720, &roi).is_none());
+        assert!(s.region(0.05, 960, 720, &roi, None).is_none());
         // A sighting from a marker with a non-finite corner is no sighting.
         let mut bad = marker([300.0, 300.0], 40.0);
         bad.corners[2][0] = f64::NAN;

@@ -15,7 +15,7 @@ use pushbot_world::camera::Homography;
 use pushbot_world::lens::Intrinsics;
 
 use super::lens::LensWarp;
-use super::render::{self, Canvas, Polygon, TagCodes};
+use super::render::{Canvas, Polygon, TagCodes};
 use super::{CameraError, Imaging};
 
 /// White paper around the tags, metres beyond the black squares' extent.
@@ -134,7 +134,7 @@ impl BoardCamera {
                 corners.push((tag.id, px.map(|q| q.unwrap_or([f64::NAN; 2]))));
             }
         }
-        render::gaussian_blur(&mut canvas.data, cw, ch, im.blur_sigma_px);
+        super::blur::gaussian_blur(&mut canvas.data, cw, ch, im.blur_sigma_px);
         let irradiance = self.warp.apply(&canvas.data, cw, ch, im.floor_shade as f32);
         let pixels = super::sensor::develop(
             &irradiance,

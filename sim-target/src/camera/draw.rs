@@ -29,7 +29,7 @@ pub struct Overlay {
 impl Camera {
     /// The homography of the plane `height` above the table: the table's own for an ideal
     /// overhead camera without a lens (its height unknown: drawn flat).
-    fn plane(&self, height: f64, what: &str) -> Result<render::Homography, CameraError> {
+    pub(super) fn plane(&self, height: f64, what: &str) -> Result<render::Homography, CameraError> {
         let table = self.config.model.table_to_pixel;
         match (&self.pose, &self.config.lens) {
             (Some(pose), Some(lens)) if height != 0.0 => {
@@ -44,7 +44,11 @@ impl Camera {
     }
 
     /// Draw marker `m` on `canvas`, on its own plane.
-    fn draw_marker(&self, canvas: &mut Canvas, m: &MarkerPlacement) -> Result<(), CameraError> {
+    pub(super) fn draw_marker(
+        &self,
+        canvas: &mut Canvas,
+        m: &MarkerPlacement,
+    ) -> Result<(), CameraError> {
         let im = &self.config.imaging;
         let plane = self.to_canvas(self.plane(m.height, &format!("marker {}", m.id))?);
         canvas
@@ -65,7 +69,7 @@ impl Camera {
     }
 
     /// The ideal image's size: the frame's, or the lens warp's larger one.
-    fn canvas_size(&self) -> (usize, usize) {
+    pub(super) fn canvas_size(&self) -> (usize, usize) {
         match &self.warp {
             Some(w) => (w.ideal_size()[0], w.ideal_size()[1]),
             None => (
@@ -77,7 +81,7 @@ impl Camera {
 
     /// A homography to ideal pixels, made to draw on the ideal image (whose origin a lens
     /// warp may move).
-    fn to_canvas(&self, h: render::Homography) -> render::Homography {
+    pub(super) fn to_canvas(&self, h: render::Homography) -> render::Homography {
         match &self.warp {
             Some(w) => w.onto_ideal_image(&h),
             None => h,
@@ -106,11 +110,7 @@ impl Camera {
             return Err(CameraError::Invalid("nothing to draw".into()));
         };
         let n = im.supersample.max(1);
-        let [tw, th] = cfg.table;
-        let table = Polygon {
-            points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]],
-            shade: im.table_shade,
-        };
+        let table = self.table();
         // The ideal image: the frame, or larger where a lens sees past it.
         let (cw, ch) = self.canvas_size();
         let h_tp = self.to_canvas(h_tp);
@@ -172,10 +172,18 @@ impl Camera {
             .iter()
             .map(|m| self.truth(m))
             .collect::<Result<Vec<_>, _>>()?;
-        render::gaussian_blur(&mut canvas.data, cw, ch, im.blur_sigma_px);
-        let irradiance = match &self.warp {
-            Some(warp) => warp.apply(&canvas.data, cw, ch, im.floor_shade as f32),
-            None => canvas.data,
+        // Of one view, the image before the blur is kept to draw the next frame where it
+        // changed ([`Camera::redraw`]).
+        let sharp = canvas.data;
+        let mut blurred = vec![0.0f32; sharp.len()];
+        let window = render::Window::full(cw, ch);
+        super::blur::gaussian_blur_window(&sharp, &mut blurred, cw, ch, im.blur_sigma_px, window);
+        let (irradiance, blurred) = match &self.warp {
+            Some(warp) => (
+                warp.apply(&blurred, cw, ch, im.floor_shade as f32),
+                Some(blurred),
+            ),
+            None => (blurred, None),
         };
         Ok(Still {
             polygons: middle.polygons.to_vec(),
@@ -183,27 +191,43 @@ impl Camera {
             overlays: overlays.to_vec(),
             irradiance,
             truth,
+            sharp: (views.len() == 1).then_some(super::Sharp {
+                data: sharp,
+                blurred,
+            }),
+        })
+    }
+
+    /// The table top, as the first polygon of every frame.
+    pub(super) fn table(&self) -> Polygon {
+        let [tw, th] = self.config.table;
+        Polygon {
+            points: vec![[0.0, 0.0], [tw, 0.0], [tw, th], [0.0, th]],
+            shade: self.config.imaging.table_shade,
+        }
+    }
+
+    /// Marker `m` with its quiet zone: the square its drawing covers.
+    pub(super) fn outer(&self, m: &MarkerPlacement) -> Result<MarkerPlacement, CameraError> {
+        let (_, tw, wab) = self.codes.pattern(m.family, m.id).ok_or_else(|| {
+            CameraError::Invalid(format!("{} has no id {}", m.family.name(), m.id))
+        })?;
+        Ok(MarkerPlacement {
+            side: m.side * (tw as f64 + 2.0 * self.config.imaging.quiet_cells) / wab as f64,
+            ..*m
         })
     }
 
     /// A marker's ground truth: its corners and centre in the frame, and whether it is wholly
     /// inside it (its quiet zone too).
-    fn truth(&self, m: &MarkerPlacement) -> Result<MarkerTruth, CameraError> {
-        let im = &self.config.imaging;
+    pub(super) fn truth(&self, m: &MarkerPlacement) -> Result<MarkerTruth, CameraError> {
         let (w, h) = (
             f64::from(self.config.model.width),
             f64::from(self.config.model.height),
         );
         let plane = self.plane(m.height, &format!("marker {}", m.id))?;
         let px = |p: [f64; 2]| self.distorted(plane.apply(p).unwrap_or([f64::NAN; 2]));
-        let (_, tw, wab) = self
-            .codes
-            .pattern(m.family, m.id)
-            .ok_or_else(|| CameraError::Invalid("bad id".into()))?;
-        let outer = MarkerPlacement {
-            side: m.side * (tw as f64 + 2.0 * im.quiet_cells) / wab as f64,
-            ..*m
-        };
+        let outer = self.outer(m)?;
         let fully_visible = outer.corners().iter().all(|&p| {
             let q = px(p);
             q[0] >= 1.0 && q[1] >= 1.0 && q[0] <= w - 1.0 && q[1] <= h - 1.0

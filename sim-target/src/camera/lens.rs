@@ -8,6 +8,8 @@
 use pushbot_world::camera::Homography;
 use pushbot_world::lens::Intrinsics;
 
+use super::render::Window;
+
 /// Where each output pixel samples the ideal image (its index-space x, y; NaN: nowhere). The
 /// ideal image is drawn larger than the frame where the lens needs it (a barrel lens sees past
 /// the ideal frame's edges): [`LensWarp::ideal_origin`] and [`LensWarp::ideal_size`].
@@ -93,27 +95,52 @@ impl LensWarp {
 
     /// The distorted image of an ideal one (`background` where the lens sees past it).
     pub fn apply(&self, ideal: &[f32], width: usize, height: usize, background: f32) -> Vec<f32> {
-        let at = |x: usize, y: usize| ideal.get(y * width + x).copied().unwrap_or(background);
         self.map
             .iter()
-            .map(|&[u, v]| {
-                if !(u.is_finite() && v.is_finite())
-                    || u < 0.0
-                    || v < 0.0
-                    || u > (width - 1) as f32
-                    || v > (height - 1) as f32
-                {
-                    return background;
-                }
-                let (x0, y0) = (u.floor() as usize, v.floor() as usize);
-                let (x1, y1) = ((x0 + 1).min(width - 1), (y0 + 1).min(height - 1));
-                let (fx, fy) = (u - x0 as f32, v - y0 as f32);
-                let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
-                let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
-                top * (1.0 - fy) + bottom * fy
-            })
+            .map(|&uv| sample(ideal, width, height, background, uv))
             .collect()
     }
+
+    /// Update `out` (a distorted image of an earlier `ideal`) where it samples `window` of the
+    /// ideal image, the only part that changed: each updated pixel exactly as [`Self::apply`]
+    /// gives it.
+    pub fn apply_within(
+        &self,
+        ideal: &[f32],
+        width: usize,
+        height: usize,
+        background: f32,
+        window: Window,
+        out: &mut [f32],
+    ) {
+        // A pixel reads ideal pixels floor(u) and floor(u) + 1 (and the same in v).
+        let (x0, y0) = (window.x0 as f32 - 1.0, window.y0 as f32 - 1.0);
+        let (x1, y1) = (window.x1 as f32, window.y1 as f32);
+        for (o, &[u, v]) in out.iter_mut().zip(&self.map) {
+            if u >= x0 && u < x1 && v >= y0 && v < y1 {
+                *o = sample(ideal, width, height, background, [u, v]);
+            }
+        }
+    }
+}
+
+/// The ideal image's irradiance at index-space `[u, v]`, bilinear; `background` outside it.
+fn sample(ideal: &[f32], width: usize, height: usize, background: f32, [u, v]: [f32; 2]) -> f32 {
+    let at = |x: usize, y: usize| ideal.get(y * width + x).copied().unwrap_or(background);
+    if !(u.is_finite() && v.is_finite())
+        || u < 0.0
+        || v < 0.0
+        || u > (width - 1) as f32
+        || v > (height - 1) as f32
+    {
+        return background;
+    }
+    let (x0, y0) = (u.floor() as usize, v.floor() as usize);
+    let (x1, y1) = ((x0 + 1).min(width - 1), (y0 + 1).min(height - 1));
+    let (fx, fy) = (u - x0 as f32, v - y0 as f32);
+    let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+    let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
+    top * (1.0 - fy) + bottom * fy
 }
 
 #[cfg(test)]
@@ -167,6 +194,34 @@ mod tests {
         );
         // Barrel: pulled towards the centre.
         assert!(want[0] > 9.0 && want[1] > 7.0, "{want:?}");
+    }
+
+    /// Warping again only where a window of the ideal image changed gives the warp of the
+    /// whole changed image.
+    #[test]
+    fn a_changed_window_warps_as_the_whole_image() {
+        use rand::{Rng, SeedableRng};
+        let warp = LensWarp::new(lens(-0.3), 64, 48).unwrap();
+        let [iw, ih] = warp.ideal_size();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+        let mut ideal: Vec<f32> = (0..iw * ih).map(|_| rng.random_range(0.0..1.0)).collect();
+        let mut out = warp.apply(&ideal, iw, ih, 0.1);
+        let (cx, cy) = (iw / 2, ih / 2);
+        let win = Window {
+            x0: cx - 10,
+            y0: cy - 7,
+            x1: cx + 11,
+            y1: cy + 8,
+        };
+        for y in win.y0..win.y1 {
+            for x in win.x0..win.x1 {
+                ideal[y * iw + x] = rng.random_range(0.0..1.0);
+            }
+        }
+        let before = out.clone();
+        warp.apply_within(&ideal, iw, ih, 0.1, win, &mut out);
+        assert_eq!(out, warp.apply(&ideal, iw, ih, 0.1));
+        assert!(out != before, "the window is in the frame");
     }
 
     #[test]

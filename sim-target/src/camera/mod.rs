@@ -7,11 +7,13 @@
 //! the table and its exact corners in pixels (pixel centres at `i + 0.5`). Frames can be written
 //! as PNG files ([`CameraFrame::write_png`]) or served over a local socket ([`server`]).
 
+pub mod blur;
 pub mod board;
 pub mod draw;
 pub mod families;
 pub mod lens;
 pub mod live;
+mod redraw;
 pub mod render;
 pub mod scene_view;
 pub mod sensor;
@@ -174,6 +176,16 @@ struct Still {
     overlays: Vec<Overlay>,
     irradiance: Vec<f32>,
     truth: Vec<MarkerTruth>,
+    /// Of a scene drawn from one view, its image before the blur (and, with a lens, after the
+    /// blur and before the warp): the next frame is drawn again only where it changed.
+    sharp: Option<Sharp>,
+}
+
+/// The ideal image of a still before the optics' blur, and its blur when a lens warps it.
+#[derive(Debug, Clone)]
+struct Sharp {
+    data: Vec<f32>,
+    blurred: Option<Vec<f32>>,
 }
 
 impl Still {
@@ -286,23 +298,55 @@ impl Camera {
         views: &[View<'_>],
         overlays: &[Overlay],
     ) -> Result<CameraFrame, CameraError> {
+        self.capture_exposure_within(time, views, overlays, None)
+    }
+
+    /// As [`Self::capture_exposure`], with the sensor read out only within `windows` (frame
+    /// pixels) when given: every other pixel is 0 and draws no noise. For a reader that looks
+    /// only there, as the host's tracker does between its whole-frame searches.
+    pub fn capture_exposure_within(
+        &mut self,
+        time: f64,
+        views: &[View<'_>],
+        overlays: &[Overlay],
+        windows: Option<&[render::Window]>,
+    ) -> Result<CameraFrame, CameraError> {
         let still = matches!(views, [v] if self.still.as_ref().is_some_and(|s| s.same(v.polygons, v.markers, overlays)));
         if !still {
-            self.still = Some(self.draw(views, overlays)?);
+            // One view after one view: drawn again where something moved; otherwise whole.
+            let redrawn = match (views, self.still.take()) {
+                ([v], Some(mut s)) => self.redraw(&mut s, v, overlays)?.then_some(s),
+                _ => None,
+            };
+            self.still = Some(match redrawn {
+                Some(s) => s,
+                None => self.draw(views, overlays)?,
+            });
         }
         let Some(still) = &self.still else {
             return Err(CameraError::Invalid("no image drawn".into()));
         };
         let cfg = &self.config;
         let im = &cfg.imaging;
-        let pixels = sensor::develop(
-            &still.irradiance,
-            im.exposure,
-            im.black_level,
-            im.white_level,
-            im.noise_sigma,
-            &mut self.rng,
-        );
+        let levels =
+            sensor::Levels::new(im.exposure, im.black_level, im.white_level, im.noise_sigma);
+        let pixels = match windows {
+            Some(w) => sensor::develop_within(
+                &still.irradiance,
+                cfg.model.width as usize,
+                w,
+                &levels,
+                &mut self.rng,
+            ),
+            None => sensor::develop(
+                &still.irradiance,
+                im.exposure,
+                im.black_level,
+                im.white_level,
+                im.noise_sigma,
+                &mut self.rng,
+            ),
+        };
         let frame = CameraFrame {
             seq: self.seq,
             time,

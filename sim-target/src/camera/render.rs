@@ -1,7 +1,7 @@
 //! Anti-aliased rendering of the table seen from above: polygons (table, bodies) and AprilTag
 //! markers drawn with their exact area coverage of each pixel (scanlines: sub-rows with exact
-//! horizontal coverage), then the optics' Gaussian blur. The sensor (exposure, noise, 8-bit
-//! quantisation) is [`super::sensor`].
+//! horizontal coverage), on the whole canvas or within a [`Window`] of it. The optics' blur is
+//! [`super::blur`], the sensor (exposure, noise, 8-bit quantisation) [`super::sensor`].
 //!
 //! Marker bit patterns come from the AprilTag library's family data ([`super::families`]), laid
 //! out exactly as its `apriltag_to_image` does.
@@ -108,6 +108,84 @@ pub struct Canvas {
     pub data: Vec<f32>,
     pixel_to_table: Homography,
     table_to_pixel: Homography,
+    /// Only the pixels of this window are drawn ([`Self::clip_to`]); the whole canvas at first.
+    clip: Window,
+}
+
+/// A rectangle of pixels: columns `x0..x1`, rows `y0..y1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Window {
+    /// First column.
+    pub x0: usize,
+    /// First row.
+    pub y0: usize,
+    /// Column past the last.
+    pub x1: usize,
+    /// Row past the last.
+    pub y1: usize,
+}
+
+impl Window {
+    /// The whole of a `width × height` image.
+    pub fn full(width: usize, height: usize) -> Window {
+        Window {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        }
+    }
+
+    /// Whether it holds no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    /// The smallest window holding both (either may be empty).
+    pub fn union(&self, other: &Window) -> Window {
+        match (self.is_empty(), other.is_empty()) {
+            (true, _) => *other,
+            (_, true) => *self,
+            _ => Window {
+                x0: self.x0.min(other.x0),
+                y0: self.y0.min(other.y0),
+                x1: self.x1.max(other.x1),
+                y1: self.y1.max(other.y1),
+            },
+        }
+    }
+
+    /// Grown by `by` pixels on every side, within a `width × height` image.
+    pub fn grown(&self, by: usize, width: usize, height: usize) -> Window {
+        Window {
+            x0: self.x0.saturating_sub(by),
+            y0: self.y0.saturating_sub(by),
+            x1: (self.x1 + by).min(width),
+            y1: (self.y1 + by).min(height),
+        }
+    }
+
+    /// The pixels a fill of points with these pixel coordinates may touch, within a
+    /// `width × height` image (as [`Canvas`] covers them); `None` when a point is not finite.
+    pub fn covering(points: &[[f64; 2]], width: usize, height: usize) -> Option<Window> {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for q in points {
+            for k in 0..2 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        if !(lo.iter().chain(&hi).all(|v| v.is_finite())) {
+            return None;
+        }
+        Some(Window {
+            x0: lo[0].floor().max(0.0) as usize,
+            y0: lo[1].floor().max(0.0) as usize,
+            x1: (hi[0].ceil() + 1.0).clamp(0.0, width as f64) as usize,
+            y1: (hi[1].ceil() + 1.0).clamp(0.0, height as f64) as usize,
+        })
+    }
 }
 
 impl Canvas {
@@ -124,7 +202,39 @@ impl Canvas {
             data: vec![fill as f32; width * height],
             pixel_to_table: table_to_pixel.inverse()?,
             table_to_pixel,
+            clip: Window::full(width, height),
         })
+    }
+
+    /// A canvas of the reflectances `data` (`width × height`, row-major) seen through
+    /// `table_to_pixel`; `None` when the sizes disagree or the homography is singular.
+    pub fn over(
+        data: Vec<f32>,
+        width: usize,
+        height: usize,
+        table_to_pixel: Homography,
+    ) -> Option<Canvas> {
+        (data.len() == width * height).then_some(())?;
+        Some(Canvas {
+            width,
+            height,
+            data,
+            pixel_to_table: table_to_pixel.inverse()?,
+            table_to_pixel,
+            clip: Window::full(width, height),
+        })
+    }
+
+    /// Draw only within `window` from now on (the whole canvas when it reaches past it): a
+    /// pixel inside is drawn exactly as without the clip.
+    pub fn clip_to(&mut self, window: Window) {
+        let full = Window::full(self.width, self.height);
+        self.clip = Window {
+            x0: window.x0.min(full.x1),
+            y0: window.y0.min(full.y1),
+            x1: window.x1.min(full.x1),
+            y1: window.y1.min(full.y1),
+        };
     }
 
     /// See the table through another homography from now on (a marker raised above the table is
@@ -156,21 +266,13 @@ impl Canvas {
     /// maps lines to lines, so what was a polygon on the table is one in pixels and is covered
     /// scanline by scanline: `n` sub-rows per pixel row, each with exact horizontal coverage.
     fn fill(&mut self, rings: &[Vec<[f64; 2]>], shade: f32, n: usize) {
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for q in rings.iter().flatten() {
-            for k in 0..2 {
-                lo[k] = lo[k].min(q[k]);
-                hi[k] = hi[k].max(q[k]);
-            }
-        }
-        if !(lo.iter().chain(&hi).all(|v| v.is_finite())) {
+        let points: Vec<[f64; 2]> = rings.iter().flatten().copied().collect();
+        let Some(w) = Window::covering(&points, self.width, self.height) else {
             return;
-        }
-        let x0 = lo[0].floor().max(0.0) as usize;
-        let y0 = lo[1].floor().max(0.0) as usize;
-        let x1 = (hi[0].ceil() + 1.0).clamp(0.0, self.width as f64) as usize;
-        let y1 = (hi[1].ceil() + 1.0).clamp(0.0, self.height as f64) as usize;
+        };
+        let c = self.clip;
+        let (x0, y0) = (w.x0.max(c.x0), w.y0.max(c.y0));
+        let (x1, y1) = (w.x1.min(c.x1), w.y1.min(c.y1));
         if x0 >= x1 || y0 >= y1 {
             return;
         }
@@ -302,52 +404,6 @@ pub fn point_in_polygon(pts: &[[f64; 2]], p: [f64; 2]) -> bool {
         j = i;
     }
     inside
-}
-
-/// Separable Gaussian blur with standard deviation `sigma` pixels (edges clamped). Both passes
-/// run along rows (the vertical one adds whole shifted rows), so the inner loops vectorise.
-pub fn gaussian_blur(data: &mut [f32], width: usize, height: usize, sigma: f64) {
-    if sigma <= 0.0 || width == 0 || height == 0 || data.len() < width * height {
-        return;
-    }
-    let r = (3.0 * sigma).ceil() as usize;
-    let mut k: Vec<f32> = (0..=2 * r)
-        .map(|i| {
-            let d = i as f64 - r as f64;
-            (-(d * d) / (2.0 * sigma * sigma)).exp() as f32
-        })
-        .collect();
-    let sum: f32 = k.iter().sum();
-    k.iter_mut().for_each(|v| *v /= sum);
-    // Horizontal: each row padded with its edge values, then a dense convolution.
-    let mut padded = vec![0.0f32; width + 2 * r];
-    let mut tmp = vec![0.0f32; width * height];
-    for (row, out) in data
-        .chunks_exact(width)
-        .zip(tmp.chunks_exact_mut(width))
-        .take(height)
-    {
-        padded[..r].fill(row[0]);
-        padded[r..r + width].copy_from_slice(row);
-        padded[r + width..].fill(row[width - 1]);
-        for (t, &kv) in k.iter().enumerate() {
-            for (o, &v) in out.iter_mut().zip(&padded[t..t + width]) {
-                *o += kv * v;
-            }
-        }
-    }
-    // Vertical: output row y is the weighted sum of rows y − r … y + r (clamped).
-    for y in 0..height {
-        let out = &mut data[y * width..(y + 1) * width];
-        out.fill(0.0);
-        for (t, &kv) in k.iter().enumerate() {
-            let yy = (y + t).saturating_sub(r).min(height - 1);
-            let src = &tmp[yy * width..(yy + 1) * width];
-            for (o, &v) in out.iter_mut().zip(src) {
-                *o += kv * v;
-            }
-        }
-    }
 }
 
 #[cfg(test)]
@@ -487,43 +543,53 @@ mod tests {
         assert!(mean < 1e-3, "mean error {mean}");
     }
 
+    /// A clipped canvas draws the pixels of its window exactly as an unclipped one, and no
+    /// other.
     #[test]
-    fn blur_keeps_mean() {
-        let mut d = vec![0.0f32; 100];
-        d[55] = 1.0;
-        gaussian_blur(&mut d, 10, 10, 0.8);
-        let s: f32 = d.iter().sum();
-        assert!((s - 1.0).abs() < 1e-4);
-        assert!(d[55] < 0.5 && d[54] > 0.0);
-    }
-
-    /// The separable blur equals the direct 2-D convolution with clamped edges, at the edges
-    /// too.
-    #[test]
-    fn blur_matches_the_direct_convolution() {
-        use rand::{Rng, SeedableRng};
-        let (w, h, sigma) = (13usize, 9usize, 0.9);
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-        let img: Vec<f32> = (0..w * h).map(|_| rng.random_range(0.0..1.0)).collect();
-        let mut fast = img.clone();
-        gaussian_blur(&mut fast, w, h, sigma);
-        let r = (3.0 * sigma).ceil() as isize;
-        let g = |d: isize| (-((d * d) as f64) / (2.0 * sigma * sigma)).exp();
-        let norm: f64 = (-r..=r).map(g).sum();
-        for y in 0..h as isize {
-            for x in 0..w as isize {
-                let mut acc = 0.0;
-                for dy in -r..=r {
-                    for dx in -r..=r {
-                        let xx = (x + dx).clamp(0, w as isize - 1) as usize;
-                        let yy = (y + dy).clamp(0, h as isize - 1) as usize;
-                        acc += g(dx) * g(dy) * f64::from(img[yy * w + xx]);
-                    }
+    fn a_clipped_canvas_draws_its_window_alone() {
+        let h = Homography([[600.0, 40.0, 10.0], [-30.0, 580.0, 15.0], [0.3, 0.2, 1.0]]);
+        let m = MarkerPlacement {
+            id: 7,
+            family: MarkerFamily::Tag36h11,
+            centre: [0.07, 0.07],
+            heading: 0.4,
+            side: 0.08,
+            height: 0.0,
+        };
+        let codes = TagCodes::new().unwrap();
+        let poly = Polygon {
+            points: vec![[0.01, 0.02], [0.15, 0.03], [0.1, 0.16]],
+            shade: 0.8,
+        };
+        let draw = |clip: Option<Window>| {
+            let mut c = Canvas::new(110, 110, h, 0.5).unwrap();
+            if let Some(w) = clip {
+                c.clip_to(w);
+            }
+            c.polygon(&poly, 8);
+            c.marker(&codes, &m, 1.0, 8, 0.04, 0.95).unwrap();
+            c.data
+        };
+        let whole = draw(None);
+        let win = Window {
+            x0: 30,
+            y0: 41,
+            x1: 77,
+            y1: 60,
+        };
+        let part = draw(Some(win));
+        let mut differs = 0;
+        for y in 0..110 {
+            for x in 0..110 {
+                let i = y * 110 + x;
+                if (win.x0..win.x1).contains(&x) && (win.y0..win.y1).contains(&y) {
+                    assert_eq!(part[i], whole[i], "({x}, {y})");
+                    differs += usize::from(whole[i] != 0.5);
+                } else {
+                    assert_eq!(part[i], 0.5, "({x}, {y}) outside the window");
                 }
-                let want = acc / (norm * norm);
-                let got = f64::from(fast[y as usize * w + x as usize]);
-                assert!((got - want).abs() < 1e-5, "({x}, {y}): {got} vs {want}");
             }
         }
+        assert!(differs > 200, "the window holds drawing ({differs} pixels)");
     }
 }

@@ -5,6 +5,7 @@
 use crate::robot::Pose;
 use crate::scene::{Marker, Scene, placed};
 
+use super::render::Window;
 use super::{Camera, CameraConfig, CameraError, CameraFrame, CameraModel, Imaging};
 use super::{MarkerFamily, MarkerPlacement, Overlay, Polygon, View};
 
@@ -155,6 +156,29 @@ impl SceneCamera {
         twist: [f64; 2],
         objects: &[(String, Pose)],
     ) -> Result<CameraFrame, CameraError> {
+        self.capture_moving_within(time, robot, twist, objects, None)
+    }
+
+    /// As [`Self::capture`], with the sensor read out only within `windows` (frame pixels;
+    /// every other pixel 0): [`Camera::capture_exposure_within`].
+    pub fn capture_within(
+        &mut self,
+        time: f64,
+        robot: &Pose,
+        objects: &[(String, Pose)],
+        windows: &[Window],
+    ) -> Result<CameraFrame, CameraError> {
+        self.capture_moving_within(time, robot, [0.0, 0.0], objects, Some(windows))
+    }
+
+    fn capture_moving_within(
+        &mut self,
+        time: f64,
+        robot: &Pose,
+        twist: [f64; 2],
+        objects: &[(String, Pose)],
+        windows: Option<&[Window]>,
+    ) -> Result<CameraFrame, CameraError> {
         let exposure = self.scene.camera.exposure;
         let reach = self.scene.robot.bumper_radius.max(
             self.scene
@@ -199,7 +223,8 @@ impl SceneCamera {
                 height: o.z,
             })
             .collect();
-        self.camera.capture_exposure(time, &views, &overlays)
+        self.camera
+            .capture_exposure_within(time, &views, &overlays, windows)
     }
 
     /// The image's scale at the table's centre, pixels per metre.

@@ -11,6 +11,8 @@ use std::sync::OnceLock;
 
 use rand::RngCore;
 
+use super::render::Window;
+
 /// Random bits per pixel, and so the size of the quantile table.
 const BITS: u32 = 16;
 
@@ -71,24 +73,77 @@ pub fn develop(
     noise_sigma: f64,
     rng: &mut impl RngCore,
 ) -> Vec<u8> {
-    let gain = ((white - black) * exposure) as f32;
-    let black = black as f32;
-    let level = |v: f32| (v.clamp(0.0, 255.0) + 0.5) as u8;
-    if !(noise_sigma > 0.0 && noise_sigma.is_finite()) {
-        return data.iter().map(|&r| level(black + gain * r)).collect();
-    }
-    let sigma = noise_sigma as f32;
-    let table = normal_quantiles();
-    let per_draw = (64 / BITS) as usize;
     let mut out = vec![0u8; data.len()];
-    for (o, d) in out.chunks_mut(per_draw).zip(data.chunks(per_draw)) {
-        let bits = rng.next_u64();
-        for (k, (o, &r)) in o.iter_mut().zip(d).enumerate() {
-            let z = table[((bits >> (BITS as usize * k)) & ((1 << BITS) - 1)) as usize];
-            *o = level(black + gain * r + sigma * z);
+    Levels::new(exposure, black, white, noise_sigma).develop_into(&mut out, data, rng);
+    out
+}
+
+/// Develop only `windows` of an image `width` pixels wide through `levels` (as [`develop`] does, with noise
+/// drawn for their pixels alone); every other pixel is 0. A reader that looks only there (a
+/// tracker searching regions around its markers) gets the frame at a fraction of the cost.
+pub fn develop_within(
+    data: &[f32],
+    width: usize,
+    windows: &[Window],
+    levels: &Levels,
+    rng: &mut impl RngCore,
+) -> Vec<u8> {
+    let mut out = vec![0u8; data.len()];
+    let height = data.len().checked_div(width).unwrap_or(0);
+    for w in windows {
+        let (x1, y1) = (w.x1.min(width), w.y1.min(height));
+        for y in w.y0..y1 {
+            if w.x0 < x1 {
+                let span = y * width + w.x0..y * width + x1;
+                levels.develop_into(&mut out[span.clone()], &data[span], rng);
+            }
         }
     }
     out
+}
+
+/// The sensor's transfer from irradiance to gray levels, with its read noise.
+#[derive(Debug, Clone, Copy)]
+pub struct Levels {
+    gain: f32,
+    black: f32,
+    /// Read noise, gray levels (0: none).
+    sigma: f32,
+}
+
+impl Levels {
+    /// Gray level `black + (white − black) · exposure · irradiance`, plus Gaussian noise of
+    /// `noise_sigma` gray levels (none when 0).
+    pub fn new(exposure: f64, black: f64, white: f64, noise_sigma: f64) -> Levels {
+        let noisy = noise_sigma > 0.0 && noise_sigma.is_finite();
+        Levels {
+            gain: ((white - black) * exposure) as f32,
+            black: black as f32,
+            sigma: if noisy { noise_sigma as f32 } else { 0.0 },
+        }
+    }
+
+    /// Develop `data` into `out` (the same length).
+    fn develop_into(&self, out: &mut [u8], data: &[f32], rng: &mut impl RngCore) {
+        let (gain, black) = (self.gain, self.black);
+        let level = |v: f32| (v.clamp(0.0, 255.0) + 0.5) as u8;
+        if self.sigma == 0.0 {
+            for (o, &r) in out.iter_mut().zip(data) {
+                *o = level(black + gain * r);
+            }
+            return;
+        }
+        let sigma = self.sigma;
+        let table = normal_quantiles();
+        let per_draw = (64 / BITS) as usize;
+        for (o, d) in out.chunks_mut(per_draw).zip(data.chunks(per_draw)) {
+            let bits = rng.next_u64();
+            for (k, (o, &r)) in o.iter_mut().zip(d).enumerate() {
+                let z = table[((bits >> (BITS as usize * k)) & ((1 << BITS) - 1)) as usize];
+                *o = level(black + gain * r + sigma * z);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -145,5 +200,59 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
         let px = develop(&[0.0, 0.5, 1.0, 2.0, -1.0], 1.0, 20.0, 235.0, 0.0, &mut rng);
         assert_eq!(px, vec![20, 128, 235, 255, 0]);
+    }
+
+    /// Developed within windows: the same levels and noise there, nothing elsewhere.
+    #[test]
+    fn developing_windows_develops_them_alone() {
+        let (w, h) = (64usize, 48usize);
+        let data: Vec<f32> = (0..w * h).map(|i| (i % 97) as f32 / 96.0).collect();
+        let windows = [
+            Window {
+                x0: 3,
+                y0: 2,
+                x1: 20,
+                y1: 10,
+            },
+            Window {
+                x0: 50,
+                y0: 40,
+                x1: 70,
+                y1: 60,
+            },
+        ];
+        let exact = develop(
+            &data,
+            1.0,
+            20.0,
+            235.0,
+            0.0,
+            &mut rand_chacha::ChaCha8Rng::seed_from_u64(1),
+        );
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let exact_levels = Levels::new(1.0, 20.0, 235.0, 0.0);
+        let part = develop_within(&data, w, &windows, &exact_levels, &mut rng);
+        let noisy_levels = Levels::new(1.0, 20.0, 235.0, 3.0);
+        let noisy = develop_within(&data, w, &windows, &noisy_levels, &mut rng);
+        let inside = |x: usize, y: usize| {
+            windows
+                .iter()
+                .any(|v| (v.x0..v.x1).contains(&x) && (v.y0..v.y1).contains(&y))
+        };
+        let (mut n, mut err) = (0, 0.0);
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                if inside(x, y) {
+                    assert_eq!(part[i], exact[i], "({x}, {y})");
+                    err += (f64::from(noisy[i]) - f64::from(exact[i])).powi(2);
+                    n += 1;
+                } else {
+                    assert_eq!((part[i], noisy[i]), (0, 0), "({x}, {y}) outside");
+                }
+            }
+        }
+        let rms = (err / f64::from(n)).sqrt();
+        assert!((2.5..3.5).contains(&rms), "noise {rms} gray levels");
     }
 }
