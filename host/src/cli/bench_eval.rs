@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::strategy_args::{MethodArg, scene_with_starts};
+use super::strategy_args::MethodArg;
 use super::{CliError, CliResult, Global};
 use crate::experiments::trials::parse_starts;
 
@@ -58,6 +58,7 @@ impl BenchEvalArgs {
 #[cfg(feature = "sim")]
 pub fn run(g: &Global, a: &BenchEvalArgs) -> CliResult {
     use super::Status;
+    use super::strategy_args::scene_with_starts;
     use crate::exec::collect::CollectParams;
     use crate::exec::deliver::DeliveryParams;
     use crate::experiments::delivery::collect_or_load;

@@ -224,6 +224,7 @@ pub enum MethodArg {
     Both,
 }
 
+#[cfg(feature = "sim")]
 impl MethodArg {
     /// The methods it names, the baseline first.
     pub fn methods(self) -> Vec<crate::experiments::strategy_eval::Method> {
@@ -237,6 +238,7 @@ impl MethodArg {
 }
 
 /// Scene `name` (a preset or a file), refused unless it has every start position of `starts`.
+#[cfg(feature = "sim")]
 pub fn scene_with_starts(name: &str, starts: &[String]) -> Result<pushbot_world::Scene, CliError> {
     let scene = pushbot_world::Scene::preset_or_file(name)
         .map_err(|e| CliError::bad_input(e.to_string()))?;

@@ -12,7 +12,7 @@ use anyhow::{Context, Result, anyhow};
 use pushbot_world::Scene;
 
 use super::inprocess::SimRef;
-use super::target::SceneCamera;
+use super::target::{SceneCamera, Window};
 use crate::vision::calibration::Calibration;
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::wrap_angle;
@@ -20,7 +20,6 @@ use crate::vision::layout::{MarkerLayout, Pose};
 use crate::vision::source::Frame;
 use crate::vision::tracking::TrackerParams;
 use crate::vision::{MotionBound, Pipeline};
-use pushbot_sim::camera::render::Window;
 
 /// Frames the calibration is fitted through (as [`crate::exec::LiveRobot`] does).
 const CALIBRATION_FRAMES: usize = 3;

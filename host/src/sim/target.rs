@@ -9,6 +9,7 @@ use pushbot_sim::{PtySim, SimOptions};
 use pushbot_world::Scene;
 
 pub use pushbot_sim::camera::SceneCamera;
+pub use pushbot_sim::camera::render::Window;
 pub use pushbot_sim::faults::{FaultArgs, LinkFaults};
 pub use pushbot_sim::perturb::Perturbation;
 pub use pushbot_sim::sim::Disturbance;
