@@ -167,7 +167,11 @@ impl Window {
 
     /// The pixels a fill of points with these pixel coordinates may touch, within a
     /// `width × height` image (as [`Canvas`] covers them); `None` when a point is not finite.
-    pub fn covering(points: &[[f64; 2]], width: usize, height: usize) -> Option<Window> {
+    pub fn covering<'a>(
+        points: impl IntoIterator<Item = &'a [f64; 2]>,
+        width: usize,
+        height: usize,
+    ) -> Option<Window> {
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
         for q in points {
@@ -266,8 +270,7 @@ impl Canvas {
     /// maps lines to lines, so what was a polygon on the table is one in pixels and is covered
     /// scanline by scanline: `n` sub-rows per pixel row, each with exact horizontal coverage.
     fn fill(&mut self, rings: &[Vec<[f64; 2]>], shade: f32, n: usize) {
-        let points: Vec<[f64; 2]> = rings.iter().flatten().copied().collect();
-        let Some(w) = Window::covering(&points, self.width, self.height) else {
+        let Some(w) = Window::covering(rings.iter().flatten(), self.width, self.height) else {
             return;
         };
         let c = self.clip;
@@ -469,11 +472,8 @@ mod tests {
         assert_eq!(c.data[4], 0.0);
     }
 
-    /// A marker turned and seen in perspective: each pixel is its exact coverage, as a
-    /// brute-force sampling of 48 × 48 points in every pixel finds it; no seam where black
-    /// cells of neighbouring rows meet.
-    #[test]
-    fn a_marker_is_drawn_with_its_coverage_of_each_pixel() {
+    /// A homography with perspective, and a turned marker 8 cm wide seen through it.
+    fn turned_marker_in_perspective() -> (Homography, MarkerPlacement) {
         let h = Homography([[600.0, 40.0, 10.0], [-30.0, 580.0, 15.0], [0.3, 0.2, 1.0]]);
         let m = MarkerPlacement {
             id: 7,
@@ -483,6 +483,15 @@ mod tests {
             side: 0.08,
             height: 0.0,
         };
+        (h, m)
+    }
+
+    /// A marker turned and seen in perspective: each pixel is its exact coverage, as a
+    /// brute-force sampling of 48 × 48 points in every pixel finds it; no seam where black
+    /// cells of neighbouring rows meet.
+    #[test]
+    fn a_marker_is_drawn_with_its_coverage_of_each_pixel() {
+        let (h, m) = turned_marker_in_perspective();
         let (black, white, quiet, old) = (0.04f32, 0.95f32, 1.0, 0.5f32);
         let codes = TagCodes::new().unwrap();
         let mut c = Canvas::new(110, 110, h, f64::from(old)).unwrap();
@@ -547,15 +556,7 @@ mod tests {
     /// other.
     #[test]
     fn a_clipped_canvas_draws_its_window_alone() {
-        let h = Homography([[600.0, 40.0, 10.0], [-30.0, 580.0, 15.0], [0.3, 0.2, 1.0]]);
-        let m = MarkerPlacement {
-            id: 7,
-            family: MarkerFamily::Tag36h11,
-            centre: [0.07, 0.07],
-            heading: 0.4,
-            side: 0.08,
-            height: 0.0,
-        };
+        let (h, m) = turned_marker_in_perspective();
         let codes = TagCodes::new().unwrap();
         let poly = Polygon {
             points: vec![[0.01, 0.02], [0.15, 0.03], [0.1, 0.16]],
