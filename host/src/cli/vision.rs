@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand};
 
 use super::{CliError, CliResult, Global, Status};
-use crate::vision::calibration::Calibration;
+use crate::vision::calibration::{Calibration, calibration_markers};
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
 use crate::vision::source::{Frame, FrameSource, SourceError, open_source};
@@ -67,7 +67,8 @@ pub struct TrackArgs {
     #[arg(long)]
     pub frames: Option<usize>,
     /// Search every whole frame for markers instead of regions around the tracked markers
-    /// (whole frames then come only every 15 frames and whenever a body is missed).
+    /// (without it, whole frames come every 15 frames while a body is not tracked, and
+    /// whenever a body is missed).
     #[arg(long, help_heading = super::ADVANCED)]
     pub whole_frames: bool,
     /// Record the frames, detections and tracked poses into this MCAP file (Foxglove schemas;
@@ -157,7 +158,7 @@ fn calibrate_from(
         };
         size = [frame.width, frame.height];
         all.push(
-            det.detect_fine(&frame)
+            calibration_markers(det.as_mut(), &frame, lay)
                 .map_err(|e| CliError::Failed(e.into()))?,
         );
     }

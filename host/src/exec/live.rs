@@ -27,7 +27,7 @@ use crate::link::LinkError;
 use crate::robot::{LinkOptions, Recovery, Robot, link_broke};
 use crate::strategy::sample::Pose2;
 use crate::vision::Pipeline;
-use crate::vision::calibration::Calibration;
+use crate::vision::calibration::{Calibration, calibration_markers};
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::MarkerLayout;
 use crate::vision::tracking::TrackerParams;
@@ -557,7 +557,7 @@ fn calibrate(
         let (n, frame) = grabber.next_after(after, timeout)?;
         after = n;
         size = [frame.width, frame.height];
-        frames.push(det.detect_fine(&frame)?);
+        frames.push(calibration_markers(det.as_mut(), &frame, layout)?);
     }
     Calibration::fit_through(&frames, layout, size, lens.as_ref()).context("calibrating the camera")
 }

@@ -13,7 +13,7 @@ use pushbot_world::Scene;
 
 use super::inprocess::SimRef;
 use super::target::{SceneCamera, Window};
-use crate::vision::calibration::Calibration;
+use crate::vision::calibration::{Calibration, calibration_markers};
 use crate::vision::detect::{DetectorKind, make_detector};
 use crate::vision::layout::wrap_angle;
 use crate::vision::layout::{MarkerLayout, Pose};
@@ -42,13 +42,20 @@ pub struct RenderedCamera {
     size: (u32, u32),
     /// The robot's odometry (its own frame) at the last look, and the look's time.
     odometry: Option<(f64, pushbot_protocol::Pose)>,
-    /// The farthest a point of the robot or of an object it pushes is from the robot's
-    /// centre, metres.
-    reach: f64,
+    /// The farthest point of the robot's edge (its bumper, its plate) from its centre, metres.
+    edge_radius: f64,
+    /// How far the robot's marker is from its centre, metres.
+    marker_radius: f64,
 }
 
 /// Odometry's error and the tracker's margin in a motion bound, metres.
 const BOUND_SLACK_M: f64 = 0.01;
+
+/// The robot's travel by the camera over its travel by odometry, at most (wheel slip).
+const ROBOT_SLIP: f64 = 1.25;
+
+/// The robot's body in the marker layout ([`MarkerLayout::from_scene`]).
+const ROBOT: &str = "robot";
 
 impl std::fmt::Debug for RenderedCamera {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -76,7 +83,7 @@ impl RenderedCamera {
             let frame = render(&mut camera, sim, seq, k as f64 * period, None)?;
             seq += 1;
             size = [frame.width, frame.height];
-            seen.push(det.detect_fine(&frame)?);
+            seen.push(calibration_markers(det.as_mut(), &frame, &layout)?);
         }
         let lens = scene.camera.optics();
         let calibration = Calibration::fit_through(&seen, &layout, size, lens.as_ref())
@@ -93,6 +100,12 @@ impl RenderedCamera {
             calibration,
             params,
         );
+        let plate = scene.robot.front_plate.iter().flat_map(|p| p.outline());
+        let edge_radius = plate
+            .map(|c| c[0].hypot(c[1]))
+            .fold(scene.robot.bumper_radius, f64::max);
+        let marker = &scene.camera.robot_marker;
+        let marker_radius = marker.x.hypot(marker.y);
         Ok(RenderedCamera {
             camera,
             pipeline,
@@ -102,14 +115,8 @@ impl RenderedCamera {
             frames: 0,
             size: (size[0], size[1]),
             odometry: None,
-            reach: scene.robot.bumper_radius
-                + 2.0
-                    * scene
-                        .objects
-                        .iter()
-                        .flat_map(|o| o.outline.iter())
-                        .map(|p| p[0].hypot(p[1]))
-                        .fold(0.0, f64::max),
+            marker_radius,
+            edge_radius,
         })
     }
 
@@ -132,15 +139,21 @@ impl RenderedCamera {
     pub fn look(&mut self, sim: &SimRef<'_>, want: &[&str]) -> Result<bool> {
         let time = sim.now_us() as f64 * 1e-6;
         let (width, height) = self.size;
-        // Nothing but the robot moves things here: what moved since the last look moved no
-        // farther than the robot's odometry says it went (twice, for a pushed object that
-        // turns about its contact), each point of it at most its reach from its centre.
+        // Nothing but the robot moves things here, and only where its edge touches them:
+        // what moved since the last look moved no farther than twice that edge's travel by
+        // the robot's odometry (a pushed object that turns about its contact); a turn moves
+        // the edge by the turn times its farthest point from the robot's centre.
         let odometry = sim.truth().odometry;
         if let Some((since, before)) = self.odometry.replace((time, odometry)) {
             let moved = f64::from(odometry.x - before.x).hypot(f64::from(odometry.y - before.y));
             let turned = wrap_angle(f64::from(odometry.theta - before.theta)).abs();
-            let metres = 2.0 * (moved + turned * self.reach) + BOUND_SLACK_M;
+            let metres = 2.0 * (moved + turned * self.edge_radius) + BOUND_SLACK_M;
             self.pipeline.bound_motion(MotionBound { since, metres });
+            // The robot's own marker went only as far as the robot, give or take its wheels'
+            // slip: a tighter region than the bound of everything it may have pushed.
+            let metres = ROBOT_SLIP * (moved + turned * self.marker_radius) + BOUND_SLACK_M;
+            self.pipeline
+                .bound_body_motion(ROBOT, MotionBound { since, metres });
         }
         let planned = self.pipeline.plan(time, width, height);
         let within = planned.as_ref().map(|rs| {

@@ -9,7 +9,8 @@ use pushbot_world::camera::Homography;
 use pushbot_world::camera_pose::CameraPose;
 use serde::{Deserialize, Serialize};
 
-use super::detection::Detection;
+use super::detection::{DetectError, Detection, Detector};
+use super::frame::Frame;
 use super::homography::{fit_homography, reprojection_errors};
 use super::layout::{MarkerLayout, Pose};
 
@@ -66,6 +67,25 @@ pub enum CalibrationError {
     /// The lens does not fit the frames.
     #[error("{0}")]
     Lens(String),
+}
+
+/// One frame's detections to calibrate from: the decimated search, and the search at full
+/// resolution only when that missed one of the layout's calibration markers (small or far
+/// markers need it; most frames do not, and it is many times slower).
+pub fn calibration_markers(
+    det: &mut dyn Detector,
+    frame: &Frame,
+    layout: &MarkerLayout,
+) -> Result<Vec<Detection>, DetectError> {
+    let found = det.detect(frame)?;
+    let all = layout
+        .calibration
+        .iter()
+        .all(|m| found.iter().any(|d| d.family == m.family && d.id == m.id));
+    if all {
+        return Ok(found);
+    }
+    det.detect_fine(frame)
 }
 
 impl Calibration {

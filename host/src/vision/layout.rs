@@ -60,6 +60,10 @@ pub struct BodyMarker {
     /// Height of the marker above the table, metres (the scene marker's `z`).
     #[serde(default)]
     pub height: f64,
+    /// Fixed to the table (a goal's marker): once seen it is looked for only where it was,
+    /// and a miss there means it is covered (the object over its goal), not that it moved.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub fixed: bool,
 }
 
 impl BodyMarker {
@@ -120,6 +124,7 @@ impl MarkerLayout {
             side,
             offset,
             height: 0.0,
+            fixed: false,
         };
         MarkerLayout {
             table: [1.2, 0.9],
@@ -142,7 +147,7 @@ impl MarkerLayout {
 
     /// The layout a scene describes: its table, its calibration markers (`[camera] fiducials`),
     /// the robot's marker (body `robot`), each object's marker (body = the object's id) and each
-    /// goal's marker (body `goal:<object id>`).
+    /// goal's marker (body `goal:<object id>`, [`BodyMarker::fixed`]).
     pub fn from_scene(scene: &pushbot_world::Scene) -> MarkerLayout {
         let body = |name: String, m: &pushbot_world::scene::Marker| BodyMarker {
             body: name,
@@ -151,6 +156,7 @@ impl MarkerLayout {
             side: m.size,
             offset: [m.x, m.y, 0.0],
             height: m.z,
+            fixed: false,
         };
         let mut bodies = vec![body("robot".into(), &scene.camera.robot_marker)];
         for o in &scene.objects {
@@ -160,7 +166,10 @@ impl MarkerLayout {
         }
         for g in &scene.goals {
             if let Some(m) = &g.marker {
-                bodies.push(body(format!("goal:{}", g.object), m));
+                bodies.push(BodyMarker {
+                    fixed: true,
+                    ..body(format!("goal:{}", g.object), m)
+                });
             }
         }
         MarkerLayout {
@@ -271,6 +280,7 @@ mod tests {
             side: 0.05,
             offset: [0.03, -0.02, 0.7],
             height: 0.0,
+            fixed: false,
         };
         let body = Pose::new(0.4, 0.3, -2.9);
         let m = b.placement(&body);

@@ -45,6 +45,7 @@ mod roi;
 pub mod simsocket;
 pub mod source;
 pub mod tracking;
+mod travel;
 pub mod undistort;
 pub mod v4l2;
 
@@ -57,6 +58,7 @@ use layout::{MarkerLayout, Pose};
 use roi::Sighting;
 pub use roi::{MotionBound, RoiParams};
 use tracking::{TrackedPose, Tracker, TrackerParams};
+use travel::Travel;
 
 /// One body's pose measured from one detection (before filtering).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -149,7 +151,9 @@ pub struct Pipeline {
     /// last one was, and the seconds to wait before the next.
     fine_backoff: Vec<(String, f64, f64)>,
     /// How far anything can have moved since some time, when the caller knows it.
-    bound: Option<MotionBound>,
+    travel: Travel,
+    /// How far one body (the robot, by its own odometry) can have moved, when the caller knows.
+    body_travel: Vec<(String, Travel)>,
 }
 
 /// Seconds between whole-frame searches at full resolution while a body is not found; the
@@ -159,9 +163,9 @@ const FINE_EVERY: f64 = 0.5;
 /// Seconds after its last sighting during which a missing body has every frame searched whole.
 const REACQUIRE_S: f64 = 5.0;
 
-/// The longest wait between whole-frame searches at full resolution for a body still not
-/// found (a goal's marker under the object): such a search is the slowest a frame can take.
-const FINE_EVERY_MAX: f64 = 8.0;
+/// The longest wait between searches at full resolution for a body still not found (a marker
+/// hidden under something): a whole-frame one is the slowest search a frame can take.
+const FINE_EVERY_MAX: f64 = 32.0;
 
 impl std::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -194,7 +198,8 @@ impl Pipeline {
             last_seen: Vec::new(),
             lens,
             fine_backoff: Vec::new(),
-            bound: None,
+            travel: Travel::default(),
+            body_travel: Vec::new(),
         }
     }
 
@@ -210,12 +215,58 @@ impl Pipeline {
         }
     }
 
-    /// Nothing on the table has moved farther than `bound` says since its time (the caller's
-    /// knowledge: its robot's odometry, when nothing else moves things): the regions around
-    /// markers seen since then reach no farther, however long the gap. A marker that moved
-    /// farther anyway is missed in its region and found by the whole-frame search after it.
+    /// Nothing on the table has moved farther than `bound` says between its time and the next
+    /// frame (the caller's knowledge: its robot's odometry, when nothing else moves things).
+    /// Given before every frame, the bounds add up: the region around a marker seen several
+    /// frames ago reaches as far as their sum since then, however long the gap. A marker that
+    /// moved farther anyway is missed in its region and found by the whole-frame search after.
     pub fn bound_motion(&mut self, bound: MotionBound) {
-        self.bound = Some(bound);
+        self.travel.add(bound);
+    }
+
+    /// As [`Self::bound_motion`], for one body only (the robot, by its own odometry): its
+    /// marker's region takes the tighter of the two.
+    pub fn bound_body_motion(&mut self, body: &str, bound: MotionBound) {
+        match self.body_travel.iter_mut().find(|(b, _)| b == body) {
+            Some((_, t)) => t.add(bound),
+            None => {
+                let mut t = Travel::default();
+                t.add(bound);
+                self.body_travel.push((body.to_string(), t));
+            }
+        }
+    }
+
+    /// The farthest `body`, seen at `seen`, can have moved by a frame at `time`, metres, as the
+    /// bounds given say; nothing for a body fixed to the table.
+    fn moved(&self, body: &str, seen: f64, time: f64) -> Option<f64> {
+        if self.is_fixed(body) {
+            return Some(0.0);
+        }
+        let all = self.travel.since(seen, time);
+        let own = self
+            .body_travel
+            .iter()
+            .find(|(b, _)| b == body)
+            .and_then(|(_, t)| t.since(seen, time));
+        match (all, own) {
+            (Some(a), Some(o)) => Some(a.min(o)),
+            (a, o) => a.or(o),
+        }
+    }
+
+    /// Whether `body`'s marker is fixed to the table ([`layout::BodyMarker::fixed`]).
+    fn is_fixed(&self, body: &str) -> bool {
+        self.layout.bodies.iter().any(|b| b.body == body && b.fixed)
+    }
+
+    /// Whether a body of the layout is neither tracked in the last frame nor fixed where it
+    /// was seen: then the scheduled whole-frame searches look for it.
+    fn untracked(&self) -> bool {
+        self.layout.bodies.iter().any(|b| {
+            let seen = |list: &[(String, Sighting)]| list.iter().any(|(n, _)| n == &b.body);
+            !seen(&self.sightings) && !(b.fixed && seen(&self.last_seen))
+        })
     }
 
     /// The same pipeline with other region-of-interest settings.
@@ -252,25 +303,24 @@ impl Pipeline {
     /// ([`Self::process_regions`]).
     pub fn plan(&self, time: f64, width: u32, height: u32) -> Option<Vec<detection::Region>> {
         if self.roi.full_every <= 1
-            || self.since_full + 1 >= self.roi.full_every
+            || (self.since_full + 1 >= self.roi.full_every && self.untracked())
             || self.sightings.is_empty()
         {
             return None;
         }
         self.expected(time)
             .iter()
-            .map(|(_, s, lost)| {
-                // A lost body may have moved farther than the bound (it was not seen when the
-                // bound began): its region reaches as far as bodies move.
-                let bound = if *lost { None } else { self.bound };
-                s.region(time, width, height, &self.roi, bound)
+            .map(|(body, s, _)| {
+                let moved = self.moved(body, s.time(), time);
+                s.region(time, width, height, &self.roi, moved)
             })
             .collect()
     }
 
     /// The bodies a frame at `time` is searched for in regions: those in the last frame, then
-    /// those seen lately but not in it (true), until they are found again or have been missing
-    /// for REACQUIRE_S (then they are hidden, and the scheduled whole-frame searches look for
+    /// those seen before but not in it (true): a body fixed to the table always (in the small
+    /// square where it lies), others until they are found again or have been missing for
+    /// REACQUIRE_S (then they are hidden, and the scheduled whole-frame searches look for
     /// them).
     fn expected(&self, time: f64) -> Vec<(String, Sighting, bool)> {
         let mut out: Vec<(String, Sighting, bool)> = self
@@ -280,7 +330,7 @@ impl Pipeline {
             .collect();
         for (body, s) in &self.last_seen {
             if !self.sightings.iter().any(|(b, _)| b == body)
-                && (0.0..REACQUIRE_S).contains(&(time - s.time()))
+                && (self.is_fixed(body) || (0.0..REACQUIRE_S).contains(&(time - s.time())))
             {
                 out.push((body.clone(), *s, true));
             }
@@ -303,13 +353,26 @@ impl Pipeline {
         for (&r, (body, _, lost)) in regions.iter().zip(&expected) {
             let mut found = self.detector.detect_region(frame, r)?;
             // A marker too small for the decimated search: look again at full resolution (not
-            // for a lost one in its wide region: the whole-frame searches do that).
-            let want = self.layout.bodies.iter().find(|b| &b.body == body);
-            if let Some(b) = want
-                && !lost
-                && !found.iter().any(|d| d.family == b.family && d.id == b.id)
+            // for a lost one in its wide region: the whole-frame searches do that; a fixed one,
+            // covered where it lies, only now and then).
+            let want = self
+                .layout
+                .bodies
+                .iter()
+                .find(|b| &b.body == body)
+                .map(|b| (b.family, b.id, b.fixed));
+            let has = |found: &[Detection], (family, id): (_, u32)| {
+                found.iter().any(|d| d.family == family && d.id == id)
+            };
+            if let Some((family, id, fixed)) = want
+                && !has(&found, (family, id))
+                && (!lost || (fixed && self.fine_due(body, frame.time)))
             {
                 found = self.detector.detect_region_fine(frame, r)?;
+                if *lost {
+                    let hit = has(&found, (family, id));
+                    self.fine_searched(body, frame.time, hit);
+                }
             }
             for d in found {
                 // Overlapping regions find the same marker twice: keep one.
@@ -342,13 +405,14 @@ impl Pipeline {
         // A body of the layout not found: search at full resolution too (its marker may be
         // small or far). Where it was last seen recently enough, only there; otherwise the
         // whole frame, every FINE_EVERY seconds at first and less often while it is not found
-        // there (hidden: the object over its goal's marker).
-        let missing: Vec<&str> = self
+        // there (hidden under something). A marker fixed to the table is looked for only where
+        // it lies, on the same backoff (the object over its goal's marker).
+        let missing: Vec<String> = self
             .layout
             .bodies
             .iter()
             .filter(|b| !ms.iter().any(|m| m.body == b.body))
-            .map(|b| b.body.as_str())
+            .map(|b| b.body.clone())
             .collect();
         let mut regions = Vec::new();
         let mut whole = Vec::new();
@@ -358,46 +422,39 @@ impl Pipeline {
                 .iter()
                 .find(|(b, _)| b == body)
                 .and_then(|(_, s)| {
-                    s.fine_region(frame.time, frame.width, frame.height, &self.roi, self.bound)
+                    let moved = self.moved(body, s.time(), frame.time);
+                    s.fine_region(frame.time, frame.width, frame.height, &self.roi, moved)
                 });
             match region {
-                Some(r) if self.roi.full_every > 1 => regions.push(r),
-                _ => whole.push(*body),
+                // A fixed marker covered where it lies: searched there now and then.
+                Some(_) if self.is_fixed(body) && !self.fine_due(body, frame.time) => {}
+                Some(r) if self.roi.full_every > 1 => regions.push((body.as_str(), r)),
+                _ => whole.push(body.as_str()),
             }
         }
-        let due = whole.iter().any(|body| {
-            self.fine_backoff
-                .iter()
-                .find(|(b, _, _)| b == body)
-                .is_none_or(|&(_, last, wait)| !(0.0..wait).contains(&(frame.time - last)))
-        });
+        let due = whole.iter().any(|body| self.fine_due(body, frame.time));
         let fine = if due {
             let fine = self.detector.detect_fine(frame)?;
             let found = self.measure_raw(&fine);
-            for body in whole {
-                let entry = self.fine_backoff.iter().position(|(b, _, _)| b == body);
-                match entry {
-                    _ if found.iter().any(|m| m.body == body) => {
-                        if let Some(i) = entry {
-                            self.fine_backoff.remove(i);
-                        }
-                    }
-                    Some(i) => {
-                        let (_, last, wait) = &mut self.fine_backoff[i];
-                        *last = frame.time;
-                        *wait = (*wait * 2.0).min(FINE_EVERY_MAX);
-                    }
-                    None => {
-                        self.fine_backoff
-                            .push((body.to_string(), frame.time, FINE_EVERY));
-                    }
-                }
+            let fixed: Vec<&str> = regions
+                .iter()
+                .map(|&(b, _)| b)
+                .filter(|b| self.is_fixed(b))
+                .collect();
+            for body in whole.into_iter().chain(fixed) {
+                let hit = found.iter().any(|m| m.body == body);
+                self.fine_searched(body, frame.time, hit);
             }
             fine
         } else {
             let mut fine = Vec::new();
-            for r in regions {
-                fine.extend(self.detector.detect_region_fine(frame, r)?);
+            for (body, r) in regions {
+                let found = self.detector.detect_region_fine(frame, r)?;
+                if self.is_fixed(body) {
+                    let hit = self.measure_raw(&found).iter().any(|m| m.body == body);
+                    self.fine_searched(body, frame.time, hit);
+                }
+                fine.extend(found);
             }
             fine
         };
@@ -411,6 +468,33 @@ impl Pipeline {
         }
         self.since_full = 0;
         Ok((dets, ms))
+    }
+
+    /// Whether a search at full resolution for `body`, not found by the last ones, is due at
+    /// `time`: every FINE_EVERY seconds at first, less often while it is not found.
+    fn fine_due(&self, body: &str, time: f64) -> bool {
+        self.fine_backoff
+            .iter()
+            .find(|(b, _, _)| b == body)
+            .is_none_or(|&(_, last, wait)| !(0.0..wait).contains(&(time - last)))
+    }
+
+    /// A search at full resolution for `body` at `time` found it (`hit`) or not: the wait
+    /// before the next starts again, or doubles up to FINE_EVERY_MAX.
+    fn fine_searched(&mut self, body: &str, time: f64, hit: bool) {
+        let entry = self.fine_backoff.iter().position(|(b, _, _)| b == body);
+        match entry {
+            Some(i) if hit => {
+                self.fine_backoff.remove(i);
+            }
+            None if hit => {}
+            Some(i) => {
+                let (_, last, wait) = &mut self.fine_backoff[i];
+                *last = time;
+                *wait = (*wait * 2.0).min(FINE_EVERY_MAX);
+            }
+            None => self.fine_backoff.push((body.to_string(), time, FINE_EVERY)),
+        }
     }
 
     /// Remember where each measured body's marker was seen.
@@ -503,6 +587,10 @@ impl Pipeline {
             (-m..=w + m).contains(&p.x) && (-m..=d + m).contains(&p.y) && p.theta.is_finite()
         });
         let off_table = before - measurements.len();
+        self.travel.frame(frame.time);
+        for (_, t) in &mut self.body_travel {
+            t.frame(frame.time);
+        }
         self.remember(frame.time, &detections, &measurements);
         let obs: Vec<(String, Pose)> = measurements
             .iter()

@@ -12,10 +12,11 @@ const ROI_STEP: f64 = 16.0;
 /// Where, and how wide, the pipeline looks between whole-frame searches.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RoiParams {
-    /// Search the whole frame at least every this many frames (0 or 1: always the whole
-    /// frame, no regions). The whole frame is also searched on the first frame, when a
-    /// region would be too wide (after a long gap, [`Self::max_speed`]), and at once whenever
-    /// a body expected in its region is not found there.
+    /// While a body of the layout is not tracked (neither found in the last frame nor fixed
+    /// where it was seen), search the whole frame at least every this many frames (0 or 1:
+    /// always the whole frame, no regions). The whole frame is also searched on the first
+    /// frame, when a region would be too wide (after a long gap, [`Self::max_speed`]), and at
+    /// once whenever a body expected in its region is not found there.
     pub full_every: u32,
     /// Pixels of margin around a marker's predicted bounding square, on each side (covers
     /// acceleration between frames and the prediction's error).
@@ -121,17 +122,18 @@ impl Sighting {
 
     /// The square to search for this marker in a `width × height` frame taken at `time`, or
     /// `None` when it would be wider than half the frame's shorter side (or the frame is
-    /// older than the sighting).
+    /// older than the sighting). `moved`: the farthest the marker can have gone since the
+    /// sighting, metres, when the caller's motion bounds say ([`super::travel`]).
     pub(super) fn region(
         &self,
         time: f64,
         width: u32,
         height: u32,
         roi: &RoiParams,
-        bound: Option<MotionBound>,
+        moved: Option<f64>,
     ) -> Option<Region> {
         let widest = f64::from(width.min(height)) / 2.0;
-        self.region_within(time, width, height, roi, bound, widest)
+        self.region_within(time, width, height, roi, moved, widest)
     }
 
     /// The square to search at full resolution for this marker, missing from a whole-frame
@@ -143,10 +145,10 @@ impl Sighting {
         width: u32,
         height: u32,
         roi: &RoiParams,
-        bound: Option<MotionBound>,
+        moved: Option<f64>,
     ) -> Option<Region> {
         let widest = f64::from(width.max(height));
-        self.region_within(time, width, height, roi, bound, widest)
+        self.region_within(time, width, height, roi, moved, widest)
     }
 
     fn region_within(
@@ -155,7 +157,7 @@ impl Sighting {
         width: u32,
         height: u32,
         roi: &RoiParams,
-        bound: Option<MotionBound>,
+        moved: Option<f64>,
         widest: f64,
     ) -> Option<Region> {
         let dt = time - self.time;
@@ -170,10 +172,8 @@ impl Sighting {
             (c, 0.0)
         } else {
             let mut reach = roi.max_speed * dt;
-            if let Some(b) = bound
-                && b.since <= self.time
-            {
-                reach = reach.min(b.metres);
+            if let Some(m) = moved {
+                reach = reach.min(m.max(0.0));
             }
             (self.centre, reach * self.px_per_m)
         };
@@ -239,18 +239,14 @@ mod tests {
         assert_eq!((r.width, r.height), (752, 720));
         assert!(s.fine_region(1.2, 960, 720, &roi, None).is_none());
         // Known to have moved at most 5 cm since the sighting: 40√2 + 40 + 2 · 40 = 176.6 →
-        // 192 px, even 0.4 s on (a bound from before the sighting covers the gap too); one from
-        // after the sighting says nothing of it.
-        let b = MotionBound {
-            since: 0.1,
-            metres: 0.05,
-        };
-        let r = s.region(0.5, 960, 720, &roi, Some(b)).unwrap();
+        // 192 px, even 0.4 s on; not moved at all: the marker's square and the margin.
+        let r = s.region(0.5, 960, 720, &roi, Some(0.05)).unwrap();
         assert_eq!((r.width, r.height), (192, 192));
-        let early = MotionBound { since: 0.0, ..b };
-        assert_eq!(s.region(0.5, 960, 720, &roi, Some(early)), Some(r));
-        let late = MotionBound { since: 0.2, ..b };
-        assert!(s.region(0.5, 960, 720, &roi, Some(late)).is_none());
+        let r = s.region(5.0, 960, 720, &roi, Some(0.0)).unwrap();
+        assert_eq!((r.width, r.height), (112, 112));
+        // A bound farther than the fastest marker goes in the gap does not widen it.
+        let r = s.region(0.4, 960, 720, &roi, Some(1.0)).unwrap();
+        assert_eq!((r.width, r.height), (352, 352));
         // A frame older than the sighting is not predicted backwards.
         assert!(s.region(0.05, 960, 720, &roi, None).is_none());
         // A sighting from a marker with a non-finite corner is no sighting.

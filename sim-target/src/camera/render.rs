@@ -288,14 +288,30 @@ impl Canvas {
             .map(|(a, b)| [a[1], b[1], a[0], (b[0] - a[0]) / (b[1] - a[1])])
             .collect();
         let n = n.max(1);
-        let mut cov = vec![0.0f64; x1 - x0];
+        // Per pixel of a row: the fractional coverage of spans' ends, and the sub-rows whose
+        // spans cover it whole (as a difference array: +1 where a run of whole pixels starts,
+        // −1 past its end), so a span costs its two ends, not its length.
+        let mut frac = vec![0.0f64; x1 - x0];
+        let mut runs = vec![0i32; x1 - x0 + 1];
         let mut xs: Vec<f64> = Vec::new();
+        let mut row_edges: Vec<[f64; 4]> = Vec::new();
         for y in y0..y1 {
-            cov.iter_mut().for_each(|c| *c = 0.0);
+            let (top, bottom) = (y as f64, (y + 1) as f64);
+            row_edges.clear();
+            row_edges.extend(
+                edges
+                    .iter()
+                    .filter(|e| e[0].min(e[1]) < bottom && e[0].max(e[1]) > top),
+            );
+            if row_edges.is_empty() {
+                continue;
+            }
+            frac.iter_mut().for_each(|c| *c = 0.0);
+            runs.iter_mut().for_each(|c| *c = 0);
             for j in 0..n {
                 let yy = y as f64 + (j as f64 + 0.5) / n as f64;
                 xs.clear();
-                for &[ya, yb, xa, slope] in &edges {
+                for &[ya, yb, xa, slope] in &row_edges {
                     if (ya > yy) != (yb > yy) {
                         xs.push(xa + (yy - ya) * slope);
                     }
@@ -308,22 +324,29 @@ impl Canvas {
                     }
                     let (ia, ib) = (xa.floor() as usize, xb.floor() as usize);
                     if ia == ib {
-                        cov[ia - x0] += xb - xa;
+                        frac[ia - x0] += xb - xa;
                         continue;
                     }
-                    cov[ia - x0] += (ia + 1) as f64 - xa;
-                    for c in &mut cov[ia + 1 - x0..ib.min(x1) - x0] {
-                        *c += 1.0;
+                    frac[ia - x0] += (ia + 1) as f64 - xa;
+                    let (start, end) = (ia + 1 - x0, ib.min(x1) - x0);
+                    if start < end {
+                        runs[start] += 1;
+                        runs[end] -= 1;
                     }
                     if ib < x1 {
-                        cov[ib - x0] += xb - ib as f64;
+                        frac[ib - x0] += xb - ib as f64;
                     }
                 }
             }
             let row = &mut self.data[y * self.width + x0..y * self.width + x1];
-            for (v, c) in row.iter_mut().zip(&cov) {
-                let c = (*c / n as f64) as f32;
-                *v = *v * (1.0 - c) + shade * c;
+            let mut whole = 0i32;
+            for ((v, f), r) in row.iter_mut().zip(&frac).zip(&runs) {
+                whole += r;
+                let covered = f + f64::from(whole);
+                if covered > 0.0 {
+                    let c = (covered / n as f64) as f32;
+                    *v = *v * (1.0 - c) + shade * c;
+                }
             }
         }
     }
