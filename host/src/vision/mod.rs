@@ -265,7 +265,7 @@ impl Pipeline {
     fn untracked(&self) -> bool {
         self.layout.bodies.iter().any(|b| {
             let seen = |list: &[(String, Sighting)]| list.iter().any(|(n, _)| n == &b.body);
-            !seen(&self.sightings) && !(b.fixed && seen(&self.last_seen))
+            !(seen(&self.sightings) || (b.fixed && seen(&self.last_seen)))
         })
     }
 
