@@ -1,6 +1,6 @@
 //! Where the pipeline spends its searches at full resolution (the slowest a frame can take):
 //! a goal's marker fixed to the table and covered (the object over it) is looked for where it
-//! lies, now and then, and found there again when it is uncovered; the marker of a body that
+//! lies, from time to time, and found there again when it is uncovered; the marker of a body that
 //! moves, once missing, is hunted across the whole frame.
 
 use std::cell::Cell;

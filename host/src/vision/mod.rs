@@ -354,7 +354,7 @@ impl Pipeline {
             let mut found = self.detector.detect_region(frame, r)?;
             // A marker too small for the decimated search: look again at full resolution (not
             // for a lost one in its wide region: the whole-frame searches do that; a fixed one,
-            // covered where it lies, only now and then).
+            // covered where it lies, only from time to time).
             let want = self
                 .layout
                 .bodies
@@ -426,7 +426,7 @@ impl Pipeline {
                     s.fine_region(frame.time, frame.width, frame.height, &self.roi, moved)
                 });
             match region {
-                // A fixed marker covered where it lies: searched there now and then.
+                // A fixed marker covered where it lies: searched there from time to time.
                 Some(_) if self.is_fixed(body) && !self.fine_due(body, frame.time) => {}
                 Some(r) if self.roi.full_every > 1 => regions.push((body.as_str(), r)),
                 _ => whole.push(body.as_str()),
