@@ -16,8 +16,58 @@ use crate::pose::Pose;
 #[derive(Clone)]
 pub struct Outline {
     parts: Vec<(PPose, SharedShape)>,
+    /// Each part's bound in the outline's frame.
+    bounds: Vec<PartBound>,
     /// Radius of a circle about the frame's origin that holds the whole outline.
     radius: f64,
+}
+
+/// Where a part lies in its outline's frame, for skipping part pairs that cannot touch.
+#[derive(Clone, Copy, Debug)]
+enum PartBound {
+    /// A circle (centre, radius) that holds the part.
+    Circle(Vector, f64),
+    /// A half-plane (no bound).
+    Plane,
+}
+
+impl PartBound {
+    /// The bound of `shape` placed at `at` in its outline's frame.
+    fn of(at: &PPose, shape: &SharedShape) -> PartBound {
+        if shape.shape_type() == ShapeType::HalfSpace {
+            return PartBound::Plane;
+        }
+        let b = shape.compute_local_bounding_sphere();
+        PartBound::Circle(at.transform_point(b.center()), b.radius())
+    }
+}
+
+/// Whether part `sa` at `posa` (its bound `ba`, in the frame of its outline at `wa`) and part
+/// `sb` at `posb` (`bb`, its outline at `wb`) are farther apart than `prediction`: then none of
+/// their contacts can be closer than it, and the pair is skipped. Exact: it only skips pairs
+/// whose bounding circles (or circle and half-plane) are apart by more than `prediction`.
+fn apart(
+    (wa, posa, sa, ba): (&PPose, &PPose, &SharedShape, PartBound),
+    (wb, posb, sb, bb): (&PPose, &PPose, &SharedShape, PartBound),
+    prediction: f64,
+) -> bool {
+    // Margin against rounding in the parts' poses, m.
+    const EPS: f64 = 1e-9;
+    let plane_apart = |pos: &PPose, s: &SharedShape, wc: &PPose, c: Vector, r: f64| {
+        s.as_halfspace().is_some_and(|h| {
+            let n = pos.transform_vector(h.normal);
+            n.dot(wc.transform_point(c) - pos.translation) > r + prediction + EPS
+        })
+    };
+    match (ba, bb) {
+        (PartBound::Circle(ca, ra), PartBound::Circle(cb, rb)) => {
+            let reach = ra + rb + prediction + EPS;
+            (wb.transform_point(cb) - wa.transform_point(ca)).length_squared() > reach * reach
+        }
+        (PartBound::Plane, PartBound::Circle(cb, rb)) => plane_apart(posa, sa, wb, cb, rb),
+        (PartBound::Circle(ca, ra), PartBound::Plane) => plane_apart(posb, sb, wa, ca, ra),
+        (PartBound::Plane, PartBound::Plane) => false,
+    }
 }
 
 impl std::fmt::Debug for Outline {
@@ -104,6 +154,15 @@ fn is_convex_ccw(pts: &[Vector]) -> bool {
 }
 
 impl Outline {
+    fn of_parts(parts: Vec<(PPose, SharedShape)>, radius: f64) -> Outline {
+        let bounds = parts.iter().map(|(at, s)| PartBound::of(at, s)).collect();
+        Outline {
+            parts,
+            bounds,
+            radius,
+        }
+    }
+
     /// A polygon (either sense, convex or not, but simple), split into convex parts.
     pub fn polygon(outline: &[[f64; 2]]) -> Result<Outline, ShapeError> {
         check_simple(outline)?;
@@ -132,24 +191,21 @@ impl Outline {
         if parts.is_empty() {
             return Err(ShapeError::Decomposition);
         }
-        Ok(Outline { parts, radius })
+        Ok(Outline::of_parts(parts, radius))
     }
 
     /// A disc of radius `r` centred on the frame's origin.
     pub fn disc(r: f64) -> Outline {
-        Outline {
-            parts: vec![(PPose::IDENTITY, SharedShape::new(Ball::new(r)))],
-            radius: r,
-        }
+        Outline::of_parts(vec![(PPose::IDENTITY, SharedShape::new(Ball::new(r)))], r)
     }
 
     /// The half-plane `{p : normal·p ≤ 0}` (a wall; `normal` points out of it).
     pub fn half_plane(normal: [f64; 2]) -> Outline {
         let n = v(normal).normalize();
-        Outline {
-            parts: vec![(PPose::IDENTITY, SharedShape::new(HalfSpace::new(n)))],
-            radius: f64::INFINITY,
-        }
+        Outline::of_parts(
+            vec![(PPose::IDENTITY, SharedShape::new(HalfSpace::new(n)))],
+            f64::INFINITY,
+        )
     }
 
     /// Add a convex part (the vertices must be convex; either sense).
@@ -157,6 +213,7 @@ impl Outline {
         let extra = Outline::polygon(outline)?;
         self.radius = self.radius.max(extra.radius);
         self.parts.extend(extra.parts);
+        self.bounds.extend(extra.bounds);
         Ok(self)
     }
 
@@ -188,10 +245,13 @@ impl Outline {
         }
         let (wa, wb) = (ppose(pa), ppose(pb));
         let dispatcher = DefaultQueryDispatcher;
-        for (ia, (la, sa)) in self.parts.iter().enumerate() {
+        for (ia, ((la, sa), &ba)) in self.parts.iter().zip(&self.bounds).enumerate() {
             let posa = wa * *la;
-            for (lb, sb) in &other.parts {
+            for ((lb, sb), &bb) in other.parts.iter().zip(&other.bounds) {
                 let posb = wb * *lb;
+                if apart((&wa, &posa, sa, ba), (&wb, &posb, sb, bb), prediction) {
+                    continue;
+                }
                 let pos12 = posa.inv_mul(&posb);
                 let mut m: ContactManifold<(), ()> = ContactManifold::new();
                 if dispatcher

@@ -92,7 +92,7 @@ pub fn bench(
             sim_s,
             trials_per_s: run as f64 / wall_s,
             realtime_factor: sim_s / wall_s,
-            threads: rayon::current_num_threads().min(starts.len() * methods.len()),
+            threads: rayon::current_num_threads().min(starts.len() * methods.len() * trials),
         })
     };
     let truth = run(SimCamera::Truth, "truth")?;

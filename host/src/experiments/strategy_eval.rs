@@ -73,7 +73,8 @@ impl TrialSetup {
 
 /// Run `trials` deliveries from `start` with `method`; the learned method starts each trial
 /// from `samples` (supplemental samples are used within a trial, not carried to the next) and,
-/// in a scene with obstacles, follows a global path through sub-goals.
+/// in a scene with obstacles, follows a global path through sub-goals. The trials run on
+/// every core (each has its own world and seed; the results are in trial order).
 pub fn run_start(
     setup: &TrialSetup,
     method: Method,
@@ -81,93 +82,106 @@ pub fn run_start(
     start: &str,
     trials: usize,
 ) -> Result<(StartResult, Vec<Delivery>)> {
+    use rayon::prelude::*;
     let goal = setup.goal()?;
-    let mut runs = Vec::with_capacity(trials);
-    for t in 0..trials {
-        let mut io = setup.robot(start, t)?;
-        let (ws, o) = (io.workspace(), io.true_object_pose());
-        if !ws.boundary.contains(o.position()) {
-            anyhow::bail!(
-                "start {start} puts the object's marker at ({:.3}, {:.3}), outside the boundary \
-                 x {:.3}..{:.3}, y {:.3}..{:.3} (a smaller --boundary-inset or a larger \
-                 --table-margin brings it inside)",
-                o.x,
-                o.y,
-                ws.boundary.min[0],
-                ws.boundary.max[0],
-                ws.boundary.min[1],
-                ws.boundary.max[1]
-            );
-        }
-        let obstacles = scene_obstacles(&setup.scene);
-        // The yardstick is the shortest path of the outline's smallest enclosing circle (the
-        // outline turning freely), from where its centre starts to where it ends (the goal is
-        // the marker's; for an object marked off its middle the centre ends up to that far
-        // from it, either side). Where the end is not clear of the walls for the circle (the
-        // object lies against one) the path to the goal stands in.
-        let from = ws.body_centre(&o);
-        let shortest_to = |to| {
-            shortest_object_path(
-                &ws.body_workspace(),
-                &obstacles,
-                from,
-                to,
-                &ObstacleParams::default(),
-            )
-            .map(|p| path_length(&p))
-        };
-        let delivered = match method {
-            Method::Learned if !setup.scene.obstacles.is_empty() => {
-                let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
-                deliver_among_obstacles(
-                    &mut io,
-                    &mut strat,
-                    goal,
-                    &obstacles,
-                    &setup.delivery,
-                    &ObstacleParams::default(),
-                    &mut |_| Ok(()),
-                )
-                .map(|d| d.delivery)
-            }
-            Method::Learned => {
-                let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
-                deliver_learned(&mut io, &mut strat, goal, &setup.delivery, &mut |_| Ok(()))
-            }
-            Method::Dipole => deliver_dipole(&mut io, goal, &setup.delivery),
-        };
-        // A body the camera lost ends this trial, not the evaluation: the trial failed (and
-        // whatever the delivery made of the poses it could no longer measure is void).
-        let mut d = match delivered {
-            Ok(d) if io.lost().is_none() => d,
-            Err(e) if io.lost().is_none() && !occlusion::is_lost(&e) => return Err(e),
-            _ => {
-                if let Some(l) = io.lost() {
-                    tracing::warn!("start {start}, trial {t}: {l}");
-                }
-                lost_delivery(&io, goal)
-            }
-        };
-        // The end is the last pose of the track the body's path was measured on (no new look).
-        let end = d.trajectory.last().map(|(_, o)| ws.body_centre(o));
-        d.shortest_path = match end {
-            Some(end) if d.success => shortest_to(end).or_else(|| shortest_to(goal)),
-            _ => shortest_to(goal),
-        };
-        tracing::debug!(
-            "start {start}, trial {t}: delivered {}, {:.1} s, body path {:.3} m, shortest {:.3} m, {} recoveries, {} re-positionings, {} camera frames, {} looks again",
-            d.success,
-            d.time,
-            d.body_path,
-            d.shortest_path.unwrap_or(f64::NAN),
-            d.recoveries.len(),
-            d.repositions,
-            io.camera_frames(),
-            io.relooks()
-        );
-        runs.push(d);
-    }
+    let runs = (0..trials)
+        .into_par_iter()
+        .map(|t| run_trial(setup, method, samples, start, t, goal))
+        .collect::<Result<Vec<_>>>()?;
     Ok((summarise(start, method, &runs), runs))
+}
+
+/// Trial `t` of [`run_start`].
+fn run_trial(
+    setup: &TrialSetup,
+    method: Method,
+    samples: &[Sample],
+    start: &str,
+    t: usize,
+    goal: Vector2<f64>,
+) -> Result<Delivery> {
+    let mut io = setup.robot(start, t)?;
+    let (ws, o) = (io.workspace(), io.true_object_pose());
+    if !ws.boundary.contains(o.position()) {
+        anyhow::bail!(
+            "start {start} puts the object's marker at ({:.3}, {:.3}), outside the boundary \
+             x {:.3}..{:.3}, y {:.3}..{:.3} (a smaller --boundary-inset or a larger \
+             --table-margin brings it inside)",
+            o.x,
+            o.y,
+            ws.boundary.min[0],
+            ws.boundary.max[0],
+            ws.boundary.min[1],
+            ws.boundary.max[1]
+        );
+    }
+    let obstacles = scene_obstacles(&setup.scene);
+    // The yardstick is the shortest path of the outline's smallest enclosing circle (the
+    // outline turning freely), from where its centre starts to where it ends (the goal is
+    // the marker's; for an object marked off its middle the centre ends up to that far
+    // from it, either side). Where the end is not clear of the walls for the circle (the
+    // object lies against one) the path to the goal stands in.
+    let from = ws.body_centre(&o);
+    let shortest_to = |to| {
+        shortest_object_path(
+            &ws.body_workspace(),
+            &obstacles,
+            from,
+            to,
+            &ObstacleParams::default(),
+        )
+        .map(|p| path_length(&p))
+    };
+    let delivered = match method {
+        Method::Learned if !setup.scene.obstacles.is_empty() => {
+            let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
+            deliver_among_obstacles(
+                &mut io,
+                &mut strat,
+                goal,
+                &obstacles,
+                &setup.delivery,
+                &ObstacleParams::default(),
+                &mut |_| Ok(()),
+            )
+            .map(|d| d.delivery)
+        }
+        Method::Learned => {
+            let mut strat = PushStrategy::new(samples.iter().copied(), setup.kernel);
+            deliver_learned(&mut io, &mut strat, goal, &setup.delivery, &mut |_| Ok(()))
+        }
+        Method::Dipole => deliver_dipole(&mut io, goal, &setup.delivery),
+    };
+    // A body the camera lost ends this trial, not the evaluation: the trial failed (and
+    // whatever the delivery made of the poses it could no longer measure is void).
+    let mut d = match delivered {
+        Ok(d) if io.lost().is_none() => d,
+        Err(e) if io.lost().is_none() && !occlusion::is_lost(&e) => return Err(e),
+        _ => {
+            if let Some(l) = io.lost() {
+                tracing::warn!("start {start}, trial {t}: {l}");
+            }
+            lost_delivery(&io, goal)
+        }
+    };
+    // The end is the last pose of the track the body's path was measured on (no new look).
+    let end = d.trajectory.last().map(|(_, o)| ws.body_centre(o));
+    d.shortest_path = match end {
+        Some(end) if d.success => shortest_to(end).or_else(|| shortest_to(goal)),
+        _ => shortest_to(goal),
+    };
+    tracing::debug!(
+        "start {start}, trial {t}: delivered {}, {:.1} s, body path {:.3} m, shortest {:.3} m, {} recoveries, {} re-positionings, {} camera frames, {} looks again",
+        d.success,
+        d.time,
+        d.body_path,
+        d.shortest_path.unwrap_or(f64::NAN),
+        d.recoveries.len(),
+        d.repositions,
+        io.camera_frames(),
+        io.relooks()
+    );
+    Ok(d)
 }
 
 /// A trial the camera's loss of a body ended: failed, with the object's true distance from the

@@ -94,12 +94,9 @@ impl RenderedCamera {
             restart_after: 1,
             ..TrackerParams::default()
         };
-        let pipeline = Pipeline::new(
-            make_detector(kind, &layout.families())?,
-            layout,
-            calibration,
-            params,
-        );
+        // The calibration's detector reads the frames from here on (building one costs its
+        // families' decode tables).
+        let pipeline = Pipeline::new(det, layout, calibration, params);
         let plate = scene.robot.front_plate.iter().flat_map(|p| p.outline());
         let edge_radius = plate
             .map(|c| c[0].hypot(c[1]))
