@@ -27,46 +27,44 @@ pub struct Outline {
 enum PartBound {
     /// A circle (centre, radius) that holds the part.
     Circle(Vector, f64),
-    /// A half-plane (no bound).
-    Plane,
+    /// A half-plane through this point with this outward normal.
+    Plane(Vector, Vector),
 }
 
 impl PartBound {
     /// The bound of `shape` placed at `at` in its outline's frame.
     fn of(at: &PPose, shape: &SharedShape) -> PartBound {
-        if shape.shape_type() == ShapeType::HalfSpace {
-            return PartBound::Plane;
+        if let Some(h) = shape.as_halfspace() {
+            return PartBound::Plane(at.translation, at.transform_vector(h.normal));
         }
         let b = shape.compute_local_bounding_sphere();
         PartBound::Circle(at.transform_point(b.center()), b.radius())
     }
+
+    /// The bound in the table frame, its outline at `w`.
+    fn at(self, w: &PPose) -> PartBound {
+        match self {
+            PartBound::Circle(c, r) => PartBound::Circle(w.transform_point(c), r),
+            PartBound::Plane(o, n) => PartBound::Plane(w.transform_point(o), w.transform_vector(n)),
+        }
+    }
 }
 
-/// Whether part `sa` at `posa` (its bound `ba`, in the frame of its outline at `wa`) and part
-/// `sb` at `posb` (`bb`, its outline at `wb`) are farther apart than `prediction`: then none of
-/// their contacts can be closer than it, and the pair is skipped. Exact: it only skips pairs
-/// whose bounding circles (or circle and half-plane) are apart by more than `prediction`.
-fn apart(
-    (wa, posa, sa, ba): (&PPose, &PPose, &SharedShape, PartBound),
-    (wb, posb, sb, bb): (&PPose, &PPose, &SharedShape, PartBound),
-    prediction: f64,
-) -> bool {
+/// Whether two parts with bounds `a` and `b` (table frame) are farther apart than
+/// `prediction`: then none of their contacts can be closer than it, and the pair is skipped.
+/// Exact: it only skips pairs whose bounding circles (or circle and half-plane) are apart by
+/// more than `prediction`.
+fn apart(a: PartBound, b: PartBound, prediction: f64) -> bool {
     // Margin against rounding in the parts' poses, m.
     const EPS: f64 = 1e-9;
-    let plane_apart = |pos: &PPose, s: &SharedShape, wc: &PPose, c: Vector, r: f64| {
-        s.as_halfspace().is_some_and(|h| {
-            let n = pos.transform_vector(h.normal);
-            n.dot(wc.transform_point(c) - pos.translation) > r + prediction + EPS
-        })
-    };
-    match (ba, bb) {
+    match (a, b) {
         (PartBound::Circle(ca, ra), PartBound::Circle(cb, rb)) => {
             let reach = ra + rb + prediction + EPS;
-            (wb.transform_point(cb) - wa.transform_point(ca)).length_squared() > reach * reach
+            (cb - ca).length_squared() > reach * reach
         }
-        (PartBound::Plane, PartBound::Circle(cb, rb)) => plane_apart(posa, sa, wb, cb, rb),
-        (PartBound::Circle(ca, ra), PartBound::Plane) => plane_apart(posb, sb, wa, ca, ra),
-        (PartBound::Plane, PartBound::Plane) => false,
+        (PartBound::Plane(o, n), PartBound::Circle(c, r))
+        | (PartBound::Circle(c, r), PartBound::Plane(o, n)) => n.dot(c - o) > r + prediction + EPS,
+        (PartBound::Plane(..), PartBound::Plane(..)) => false,
     }
 }
 
@@ -249,7 +247,7 @@ impl Outline {
             let posa = wa * *la;
             for ((lb, sb), &bb) in other.parts.iter().zip(&other.bounds) {
                 let posb = wb * *lb;
-                if apart((&wa, &posa, sa, ba), (&wb, &posb, sb, bb), prediction) {
+                if apart(ba.at(&wa), bb.at(&wb), prediction) {
                     continue;
                 }
                 let pos12 = posa.inv_mul(&posb);
