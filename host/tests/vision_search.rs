@@ -211,3 +211,46 @@ fn a_missing_marker_of_a_moving_body_is_hunted_in_the_whole_frame() {
     assert!(r.covered_whole_frames >= 5, "{}", r.covered_whole_frames);
     assert!(r.goal_back_after.is_some_and(|k| k <= 9));
 }
+
+/// After a gap longer than `max_gap` a region reaches as far as the caller's motion bound says
+/// the marker can have gone: a marker missed there is covered, and the frame goes on without
+/// it (no whole frame). Without a bound, the same miss costs the whole frame.
+#[test]
+fn a_marker_missed_where_its_motion_bound_put_it_costs_no_whole_frame() {
+    let (layout, open, covered) = still_scene();
+    let gap = 0.5;
+    for bounded in [true, false] {
+        let (mut pipe, counts) = counting_pipeline(&layout, &open);
+        for seq in 0..10 {
+            pipe.process(&at(&open, seq)).unwrap();
+        }
+        let last = at(&open, 9).time;
+        if bounded {
+            pipe.bound_motion(pushbot::vision::MotionBound {
+                since: last,
+                metres: 0.01,
+            });
+        }
+        let whole0 = counts.whole.get();
+        let frame = Frame {
+            seq: 10,
+            time: last + gap,
+            ..covered.clone()
+        };
+        let r = pipe.process(&frame).unwrap();
+        let seen = |body: &str| r.measurements.iter().any(|m| m.body == body);
+        assert!(!seen(GOAL), "the covered goal is not seen");
+        for b in layout.bodies.iter().filter(|b| b.body != GOAL) {
+            assert!(seen(&b.body), "{} is seen", b.body);
+        }
+        let whole = counts.whole.get() - whole0;
+        eprintln!("bounded {bounded}: {whole} whole-frame searches");
+        if bounded {
+            assert!(!r.full_frame);
+            assert_eq!(whole, 0);
+        } else {
+            assert!(r.full_frame);
+            assert_eq!(whole, 1);
+        }
+    }
+}

@@ -131,8 +131,9 @@ impl RenderedCamera {
     /// when empty) was seen in it.
     ///
     /// Between whole-frame searches the sensor is read out only in the regions the tracker
-    /// will search ([`Pipeline::plan`]); when they miss a body, the same image is read out
-    /// whole (fresh noise) and searched whole, as the pipeline does a camera's full frame.
+    /// will search ([`Pipeline::plan`]); when they miss a body the pipeline cannot take as
+    /// covered ([`Pipeline::process_regions`]), the same image is read out whole (fresh noise)
+    /// and searched whole, as the pipeline does a camera's full frame.
     pub fn look(&mut self, sim: &SimRef<'_>, want: &[&str]) -> Result<bool> {
         let time = sim.now_us() as f64 * 1e-6;
         let (width, height) = self.size;

@@ -339,7 +339,7 @@ impl Pipeline {
     }
 
     /// Detect and measure in `regions` (as [`Self::plan`] gave them, one per body seen in the
-    /// last frame); `None` when they do not find every body expected.
+    /// last frame); `None` when they miss a body they should have found ([`Self::bounded`]).
     fn look_regions(
         &mut self,
         frame: &Frame,
@@ -387,15 +387,30 @@ impl Pipeline {
             }
         }
         let ms = self.measure_raw(&dets);
+        // A body missed where its motion bound put it is covered, not gone: the frame goes on
+        // without it (the scheduled whole-frame searches look for it while it is untracked). A
+        // body missed where only its velocity put it may have turned: the whole frame is due.
         if self
             .sightings
             .iter()
-            .all(|(b, _)| ms.iter().any(|m| &m.body == b))
+            .all(|(b, s)| ms.iter().any(|m| &m.body == b) || self.bounded(b, s.time(), frame.time))
         {
             self.since_full += 1;
             return Ok(Some((dets, ms)));
         }
         Ok(None)
+    }
+
+    /// Whether the region of `body`, seen at `seen`, in a frame at `time` was drawn by the
+    /// motion bounds given ([`Self::bound_motion`]): after a gap longer than `max_gap`, with
+    /// the body's bound tighter than `max_speed` allows. The marker is then inside it or
+    /// covered.
+    fn bounded(&self, body: &str, seen: f64, time: f64) -> bool {
+        let gap = time - seen;
+        gap > self.roi.max_gap
+            && self
+                .moved(body, seen, time)
+                .is_some_and(|m| m <= self.roi.max_speed * gap)
     }
 
     /// Detect and measure in the whole frame (and at full resolution where a body is missing).
@@ -526,7 +541,7 @@ impl Pipeline {
     }
 
     /// Process one frame: searched in the regions of interest when they are due and find
-    /// every body expected, in the whole frame otherwise.
+    /// every body they should ([`Self::bounded`]), in the whole frame otherwise.
     pub fn process(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
         self.check_size(frame)?;
         if let Some(regions) = self.plan(frame.time, frame.width, frame.height)
@@ -538,8 +553,9 @@ impl Pipeline {
     }
 
     /// Process a frame of which only `regions` (as [`Self::plan`] gave them for it) are read:
-    /// `None`, and nothing learnt, when they do not find every body expected — then the whole
-    /// frame is needed ([`Self::process_whole`]).
+    /// `None`, and nothing learnt, when they miss a body that only its velocity placed (it may
+    /// have turned away) — then the whole frame is needed ([`Self::process_whole`]). A body
+    /// missed in a region its motion bound drew is covered: the result leaves it unseen.
     pub fn process_regions(
         &mut self,
         frame: &Frame,

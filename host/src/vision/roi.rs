@@ -16,7 +16,8 @@ pub struct RoiParams {
     /// where it was seen), search the whole frame at least every this many frames (0 or 1:
     /// always the whole frame, no regions). The whole frame is also searched on the first
     /// frame, when a region would be too wide (after a long gap, [`Self::max_speed`]), and at
-    /// once whenever a body expected in its region is not found there.
+    /// once whenever a body expected where its velocity put it is not found there (one missed
+    /// where its motion bound put it is covered, and waits for the scheduled searches).
     pub full_every: u32,
     /// Pixels of margin around a marker's predicted bounding square, on each side (covers
     /// acceleration between frames and the prediction's error).
