@@ -541,7 +541,8 @@ impl Pipeline {
     }
 
     /// Process one frame: searched in the regions of interest when they are due and find
-    /// every body they should ([`Self::bounded`]), in the whole frame otherwise.
+    /// every body they should (one missed where its motion bound put it is covered), in the
+    /// whole frame otherwise.
     pub fn process(&mut self, frame: &Frame) -> Result<FrameResult, DetectError> {
         self.check_size(frame)?;
         if let Some(regions) = self.plan(frame.time, frame.width, frame.height)
