@@ -245,11 +245,12 @@ impl Outline {
         let dispatcher = DefaultQueryDispatcher;
         for (ia, ((la, sa), &ba)) in self.parts.iter().zip(&self.bounds).enumerate() {
             let posa = wa * *la;
+            let ba = ba.at(&wa);
             for ((lb, sb), &bb) in other.parts.iter().zip(&other.bounds) {
-                let posb = wb * *lb;
-                if apart(ba.at(&wa), bb.at(&wb), prediction) {
+                if apart(ba, bb.at(&wb), prediction) {
                     continue;
                 }
+                let posb = wb * *lb;
                 let pos12 = posa.inv_mul(&posb);
                 let mut m: ContactManifold<(), ()> = ContactManifold::new();
                 if dispatcher

@@ -5,6 +5,7 @@
 use anyhow::{Result, anyhow};
 use nalgebra::Vector2;
 use pushbot_world::Scene;
+use rayon::prelude::*;
 
 pub use super::trials::{Method, StartResult, parse_starts, summarise};
 use crate::exec::collect::CollectReport;
@@ -82,7 +83,6 @@ pub fn run_start(
     start: &str,
     trials: usize,
 ) -> Result<(StartResult, Vec<Delivery>)> {
-    use rayon::prelude::*;
     let goal = setup.goal()?;
     let runs = (0..trials)
         .into_par_iter()
@@ -259,7 +259,6 @@ pub fn evaluate_cells(
     resumed: &ResumedCells<'_>,
     report: &CellReport<'_>,
 ) -> Result<(Vec<StartResult>, Vec<LabelledRun>)> {
-    use rayon::prelude::*;
     let done = cells
         .par_iter()
         .map(|(s, m)| {
