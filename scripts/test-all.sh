@@ -125,48 +125,22 @@ fi
 say "tests: building"
 cargo test --workspace --no-run
 
-# The hardware-in-the-loop tests (the `tests` crate: the real host against the simulated robot,
-# paced at five times real time, on a pty) wait on the robot much of the time: the longest,
-# strategy_hil, takes 145 s of wall time for 159 s of CPU on two cores. So they run beside the
-# others, which run at a lower priority and take what the robot's pace leaves. Both runs select
-# the whole workspace, so the features resolve as in the build above and nothing is compiled
-# again; every test target runs in exactly one of them (a name in both is an error).
-test_targets() {
-  cargo metadata --format-version 1 --no-deps | python3 -c '
-import json, sys
-hil, rest = set(), set()
-for p in json.load(sys.stdin)["packages"]:
-    for t in p["targets"]:
-        if "test" in t["kind"]:
-            (hil if p["name"] == "pushbot-tests" else rest).add(t["name"])
-if hil & rest:
-    sys.exit("test targets named alike in the tests crate and elsewhere: " + " ".join(sorted(hil & rest)))
-print(" ".join("--test " + n for n in sorted(hil if sys.argv[1] == "hil" else rest)))
-' "$1"
-}
-hil_targets=$(test_targets hil)
-rest_targets=$(test_targets rest)
-say "tests: the hardware-in-the-loop tests in the background, the others beside them"
-hil_log=$(mktemp)
-# shellcheck disable=SC2086 # one word per target option
-cargo test --workspace $hil_targets >"$hil_log" 2>&1 &
-hil_pid=$!
-trap 'kill "$hil_pid" ${boards_pid:+"$boards_pid"} 2>/dev/null || true' EXIT
-rest_status=0
-# shellcheck disable=SC2086
-nice -n 10 cargo test --workspace --lib --bins $rest_targets || rest_status=$?
-if [ "$rest_status" -eq 0 ]; then
-  nice -n 10 cargo test --workspace --doc || rest_status=$?
+# Every test binary (unit, property and hardware-in-the-loop tests), three at a time, by
+# scripts/run-tests.py: the hardware-in-the-loop tests (the `tests` crate: the real host against
+# the simulated robot, paced at five times real time, on a pty) wait on the robot most of the
+# time (5 minutes of wall time for 1.8 minutes of CPU, run one binary at a time), so they run beside each
+# other and beside the rest, which run at nice 10 and take what the robot's pace leaves. The
+# binaries are those `cargo test --workspace` built above: nothing is compiled again.
+say "tests: every test binary, three at a time"
+tests_status=0
+cargo test --workspace --no-run --message-format=json 2>/dev/null \
+  | python3 scripts/run-tests.py --jobs 3 || tests_status=$?
+if [ "$tests_status" -eq 0 ]; then
+  say "tests: the doc tests"
+  nice -n 10 cargo test --workspace --doc || tests_status=$?
 fi
-hil_status=0
-wait "$hil_pid" || hil_status=$?
-say "tests: the hardware-in-the-loop tests' output"
-cat "$hil_log"
-rm -f "$hil_log"
-trap '[ -z "${boards_pid:-}" ] || kill "$boards_pid" 2>/dev/null || true' EXIT
-if [ "$rest_status" -ne 0 ] || [ "$hil_status" -ne 0 ]; then
-  echo "tests failed (the host's, simulator's and firmware's: exit $rest_status;" \
-    "hardware-in-the-loop: exit $hil_status)" >&2
+if [ "$tests_status" -ne 0 ]; then
+  echo "tests failed (exit $tests_status)" >&2
   exit 1
 fi
 

@@ -107,6 +107,15 @@ pub fn bin(name: &str) -> std::path::PathBuf {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let mut cmd = std::process::Command::new(cargo);
         cmd.args(["test", "--quiet", "--workspace", "--no-run"]);
+        // The variables the outer cargo sets for this test process describe this package, not
+        // the build: build scripts that watch them (ring's watches `CARGO_PKG_NAME` and
+        // `CARGO_MANIFEST_DIR`) would run again, and every crate above them be compiled again,
+        // once here and once more in the next plain `cargo test` (minutes in CI).
+        for (key, _) in std::env::vars_os() {
+            if key.to_str().is_some_and(set_by_cargo_for_a_crate) {
+                cmd.env_remove(key);
+            }
+        }
         // target/release holds `cargo test --release`'s build.
         if dir.file_name().is_some_and(|p| p == "release") {
             cmd.arg("--release");
@@ -128,6 +137,25 @@ pub fn bin(name: &str) -> std::path::PathBuf {
     }
     assert!(path.exists(), "{} was not built", path.display());
     path
+}
+
+/// Whether cargo sets the environment variable `key` for the crate it builds or runs (its
+/// package's name, version and folders), as opposed to a setting of the build itself.
+fn set_by_cargo_for_a_crate(key: &str) -> bool {
+    key.starts_with("CARGO_PKG_")
+        || key.starts_with("CARGO_BIN_EXE_")
+        || matches!(
+            key,
+            "OUT_DIR"
+                | "CARGO_MANIFEST_DIR"
+                | "CARGO_MANIFEST_PATH"
+                | "CARGO_MANIFEST_LINKS"
+                | "CARGO_CRATE_NAME"
+                | "CARGO_BIN_NAME"
+                | "CARGO_PRIMARY_PACKAGE"
+                | "CARGO_TARGET_TMPDIR"
+                | "CARGO_RUSTC_CURRENT_DIR"
+        )
 }
 
 /// What a run of a binary gave: exit code (`None`: killed by a signal), stdout, stderr.
