@@ -31,7 +31,7 @@ LONG_FIRST = ["strategy_hil", "recording", "console_browser", "rearrange_live"]
 
 
 def binaries(messages):
-    """The test executables in cargo's JSON messages: (package, target name, kind, path, dir)."""
+    """The test executables in cargo's JSON messages: package, target name, kind, path, folder."""
     found = []
     for line in messages:
         line = line.strip()
